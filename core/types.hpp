@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Plain data shared by every module: frames from a depth sensor, and the raster origin.
+// Frames follow ../shared/docs/conventions.md: world z up; camera optical frame x right,
+// y down, z forward; body frame x forward, y left, z up.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <vector>
+
+namespace sonomap {
+
+// One depth frame as the mapper sees it.
+struct Frame {
+  int index = 0;
+  double time = 0.0;  // seconds since the start of the run (fixed time step)
+  int width = 0;
+  int height = 0;
+  // Row-major z-depth in metres, width*height values. 0 means "no return" (out of range,
+  // invalidated by the noise model, or nothing hit). Never NaN.
+  std::vector<float> depth;
+  // The valid pixels back-projected into the camera optical frame (x right, y down, z forward).
+  std::vector<Eigen::Vector3f> points_camera;
+  // Camera pose in the world as handed to the mapper (localisation estimate) ...
+  Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
+  // ... and the body (listener) pose that goes with it; rasters are centred on the body
+  // position with the body heading.
+  Eigen::Isometry3d world_T_body = Eigen::Isometry3d::Identity();
+  // The true poses (simulation only; ground truth always uses these).
+  Eigen::Isometry3d world_T_camera_true = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d world_T_body_true = Eigen::Isometry3d::Identity();
+};
+
+// Where a raster is centred: a position and a heading (yaw of the body x axis, radians),
+// with the ground height the obstacle band is measured from.
+struct RasterOrigin {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double heading = 0.0;
+  double ground_z = 0.0;
+};
+
+// Heading psi = yaw of the body x axis in the world.
+inline double heading_of(const Eigen::Isometry3d& world_T_body) {
+  const Eigen::Vector3d x = world_T_body.linear().col(0);
+  return std::atan2(x.y(), x.x());
+}
+
+inline RasterOrigin raster_origin(const Eigen::Isometry3d& world_T_body, double ground_z = 0.0) {
+  return RasterOrigin{world_T_body.translation(), heading_of(world_T_body), ground_z};
+}
+
+}  // namespace sonomap

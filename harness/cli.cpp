@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/cli.hpp"
+
+#include "harness/errors.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <tbb/global_control.h>
+
+namespace sonomap::harness {
+
+std::string code_version() { return std::string(SONOMAP_VERSION) + " (" SONOMAP_GIT_VERSION ")"; }
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{"sonomap: depth sensing -> online map -> 360-degree rasters -> binaural sound"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", code_version());
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "No progress bar and no summary screen");
+  app.add_option("--threads", global.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  std::unique_ptr<tbb::global_control> thread_limit;
+  app.parse_complete_callback([&] {
+    if (global.threads > 0)
+      thread_limit = std::make_unique<tbb::global_control>(
+          tbb::global_control::max_allowed_parallelism, global.threads);
+  });
+
+  // Commands: one line each (declared in cli.hpp).
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitBadInput;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "sonomap: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sonomap: failure: %s\n", e.what());
+    return kExitFailure;
+  }
+  return 0;
+}
+
+}  // namespace sonomap::harness

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The `sonomap` command line: a thin layer over harness functions that tests can call.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace sonomap::harness {
+
+// Options every command understands.
+struct GlobalOptions {
+  bool quiet = false;  // no progress bar, no summary screen
+  int threads = 0;     // 0: all cores
+};
+
+// Each command lives in its own source file and registers itself here.
+// The callback it sets runs after parsing; it throws InputError for bad input.
+// (one line per command: add yours here and in run_cli)
+
+// Parses argv and runs the chosen command. Returns the process exit status:
+// 0 success, 2 bad input (message names file, line and key), 1 other failure.
+int run_cli(int argc, char** argv);
+
+// The code version recorded in every result ("0.1.0 (git describe)").
+std::string code_version();
+
+}  // namespace sonomap::harness
