@@ -2,11 +2,13 @@
 // Sensor-centric rasters (conventions.md): the 2D circle (azimuth bins) and the 3D cylinder
 // (azimuth bins x height rows). Each cell keeps the minimum horizontal range of the obstacle
 // points that fall in it, and that point. Unknown is +infinity, distinct from any range.
+// The sonification sectors (groups of bins) are a pure function of a circle.
 #pragma once
 
 #include "core/types.hpp"
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -21,6 +23,14 @@ struct RasterConfig {
   double row_height = 0.1;    // cylinder rows over [band_min, band_max]
   double max_range = 5.0;     // horizontal range beyond which points are ignored
   int rows() const;           // number of cylinder rows
+  // Throws std::invalid_argument naming the field unless: azimuth_bins in [1, 36000], all
+  // values finite, band_min < band_max, row_height > 0 with at least one row, max_range > 0.
+  void validate() const;
+  double bin_width_deg() const { return 360.0 / azimuth_bins; }
+  // Row r covers heights [band_min + r * row_height, band_min + (r + 1) * row_height] above
+  // the ground (the cylinder covers [band_min, band_min + rows() * row_height]).
+  double row_bottom(int row) const { return band_min + row * row_height; }
+  double row_top(int row) const { return band_min + (row + 1) * row_height; }
 };
 
 struct RasterCell {
@@ -31,16 +41,51 @@ struct RasterCell {
 
 struct Circle {
   std::vector<RasterCell> bins;  // azimuth_bins cells
+
+  Circle() = default;
+  explicit Circle(int azimuth_bins) : bins(static_cast<size_t>(azimuth_bins)) {}
+  int size() const { return static_cast<int>(bins.size()); }
+  double bin_width_deg() const { return 360.0 / static_cast<double>(bins.size()); }
+  // Bin k holds azimuths [k, k + 1) * bin width; its centre is at (k + 0.5) * bin width.
+  double bin_centre_deg(int bin) const { return (bin + 0.5) * bin_width_deg(); }
+  int known_count() const;
+  void clear();  // every bin unknown, size kept
 };
 
 struct Cylinder {
   int azimuth_bins = 0;
   int rows = 0;
   std::vector<RasterCell> cells;  // row-major: cells[row * azimuth_bins + bin]
+
+  Cylinder() = default;
+  Cylinder(int azimuth_bins_, int rows_)
+      : azimuth_bins(azimuth_bins_), rows(rows_),
+        cells(static_cast<size_t>(azimuth_bins_) * static_cast<size_t>(rows_)) {}
   RasterCell& at(int row, int bin) { return cells[static_cast<size_t>(row) * azimuth_bins + bin]; }
   const RasterCell& at(int row, int bin) const {
     return cells[static_cast<size_t>(row) * azimuth_bins + bin];
   }
+  int known_count() const;
+  void clear();  // every cell unknown, size kept
 };
+
+// Empty rasters shaped by a config (every cell unknown).
+Circle make_circle(const RasterConfig& config);
+Cylinder make_cylinder(const RasterConfig& config);
+
+// One sonification sector (conventions.md "Sectors"): the bin with the smallest range among
+// the sector's bins. Ties go to the lowest bin index (the first met counter-clockwise).
+struct Sector {
+  float range = kUnknownRange;  // range of the closest bin; unknown if every bin is unknown
+  double angle_deg = NAN;       // centre angle of that bin, degrees in [0, 360)
+  int bin = -1;                 // its index in the circle, -1 when unknown
+  Eigen::Vector3f point = Eigen::Vector3f::Constant(NAN);  // the world point that set it
+  bool known() const { return range != kUnknownRange; }
+};
+
+// Splits the circle into `sector_count` equal sectors: sector s holds bins
+// [s * n, (s + 1) * n) with n = bins / sector_count (36 sectors of 10 one-degree bins by default).
+// Throws std::invalid_argument unless sector_count > 0 divides the number of bins.
+std::vector<Sector> circle_sectors(const Circle& circle, int sector_count = 36);
 
 }  // namespace sonomap

@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "core/rasteriser.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace sonomap {
+
+namespace {
+
+constexpr double kDegreesPerRadian = 180.0 / M_PI;
+constexpr double kAxisRange = 1e-9;      // metres: closer to the vertical axis has no azimuth
+constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at bin edges
+
+}  // namespace
+
+Rasteriser::Rasteriser(const RasterConfig& config) : config_(config) {
+  config_.validate();
+  circle_ = make_circle(config_);
+  cylinder_ = make_cylinder(config_);
+}
+
+void Rasteriser::reset(const RasterOrigin& origin) {
+  if (!origin.position.allFinite() || !std::isfinite(origin.heading) ||
+      !std::isfinite(origin.ground_z)) {
+    throw std::invalid_argument("Rasteriser::reset: raster origin is not finite");
+  }
+  origin_ = origin;
+  cos_heading_ = std::cos(origin.heading);
+  sin_heading_ = std::sin(origin.heading);
+  circle_.clear();
+  cylinder_.clear();
+}
+
+void Rasteriser::add(const Eigen::Vector3f& point) {
+  if (!point.allFinite()) return;
+  const double height = static_cast<double>(point.z()) - origin_.ground_z;
+  if (!(height >= config_.band_min && height <= config_.band_max)) return;
+
+  const double dx = static_cast<double>(point.x()) - origin_.position.x();
+  const double dy = static_cast<double>(point.y()) - origin_.position.y();
+  const double range = std::hypot(dx, dy);
+  if (range > config_.max_range || range < kAxisRange) return;
+
+  // Rotate the offset by -heading into the body frame (x ahead, y left).
+  const double x = cos_heading_ * dx + sin_heading_ * dy;
+  const double y = -sin_heading_ * dx + cos_heading_ * dy;
+  double bin_position = std::atan2(y, x) * kDegreesPerRadian / config_.bin_width_deg();
+  if (bin_position < 0.0) bin_position += config_.azimuth_bins;
+  const double nearest_edge = std::round(bin_position);
+  if (std::abs(bin_position - nearest_edge) < kEdgeSnapDeg / config_.bin_width_deg()) {
+    bin_position = nearest_edge;
+  }
+  int bin = static_cast<int>(std::floor(bin_position));
+  if (bin >= config_.azimuth_bins) bin -= config_.azimuth_bins;  // 360 wraps to 0
+
+  const auto range_f = static_cast<float>(range);
+  RasterCell& cell = circle_.bins[static_cast<size_t>(bin)];
+  if (range_f < cell.range) cell = RasterCell{range_f, point};
+
+  int row = static_cast<int>(std::floor((height - config_.band_min) / config_.row_height));
+  // The top edge of the last row is inside it (the band is closed); rounding of the
+  // division must not push it out.
+  if (row == cylinder_.rows && height <= config_.row_top(cylinder_.rows - 1) + 1e-9) {
+    row = cylinder_.rows - 1;
+  }
+  if (row >= cylinder_.rows) return;
+  RasterCell& cyl_cell = cylinder_.at(row, bin);
+  if (range_f < cyl_cell.range) cyl_cell = RasterCell{range_f, point};
+}
+
+void Rasteriser::add(const Eigen::Vector3f* points, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) add(points[i]);
+}
+
+}  // namespace sonomap

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Builds the circle and the cylinder (conventions.md) from world points around a RasterOrigin.
+// One accumulator reused frame after frame: reset() clears the cells, add() is O(1) per point
+// and never allocates, so a raster from N points costs O(N + cells).
+#pragma once
+
+#include "core/raster.hpp"
+#include "core/types.hpp"
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace sonomap {
+
+class Rasteriser {
+ public:
+  // Throws std::invalid_argument if the config is invalid (RasterConfig::validate).
+  explicit Rasteriser(const RasterConfig& config = {});
+
+  // Starts a new raster around `origin`: every cell unknown. Throws std::invalid_argument if
+  // the origin's position, heading or ground height is not finite.
+  void reset(const RasterOrigin& origin);
+
+  // Adds one world point. It counts when its height above the ground, z - ground_z, lies in
+  // [band_min, band_max] and its horizontal range |(q - o).xy| is at most max_range.
+  // Points that are skipped, by design:
+  //  - non-finite coordinates (NaN / inf);
+  //  - a point on the sensor's vertical axis (horizontal range below 1e-9 m): it has no
+  //    azimuth, and such a point is the listener's own body, not an obstacle around it.
+  // Azimuths within 1e-9 degrees of a bin edge are snapped onto the edge, so a point exactly
+  // on an edge always belongs to the bin above it (and 359.9999999999 wraps to bin 0).
+  // The cylinder row is floor((z - ground_z - band_min) / row_height); the band's top edge
+  // belongs to the last row, heights above the last row's top only reach the circle.
+  void add(const Eigen::Vector3f& point);
+  void add(const Eigen::Vector3f* points, std::size_t count);
+  void add(const std::vector<Eigen::Vector3f>& points) { add(points.data(), points.size()); }
+
+  const Circle& circle() const { return circle_; }
+  const Cylinder& cylinder() const { return cylinder_; }
+  const RasterConfig& config() const { return config_; }
+  const RasterOrigin& origin() const { return origin_; }
+
+ private:
+  RasterConfig config_;
+  RasterOrigin origin_;
+  double cos_heading_ = 1.0;
+  double sin_heading_ = 0.0;
+  Circle circle_;
+  Cylinder cylinder_;
+};
+
+}  // namespace sonomap

@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Hand-placed points give hand-computed bins (conventions.md "Azimuth", "2D circle", "3D cylinder").
+#include "core/rasteriser.hpp"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <stdexcept>
+
+using namespace sonomap;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A point at `azimuth_deg` (world, counter-clockwise from +x), horizontal range r, height z.
+Eigen::Vector3f polar(double azimuth_deg, double r, double z) {
+  return Eigen::Vector3f(static_cast<float>(r * std::cos(azimuth_deg * kDeg)),
+                         static_cast<float>(r * std::sin(azimuth_deg * kDeg)),
+                         static_cast<float>(z));
+}
+
+Rasteriser at_origin(const RasterConfig& config = {}) {
+  Rasteriser r(config);
+  r.reset(RasterOrigin{});
+  return r;
+}
+
+// Indices of the known bins.
+std::vector<int> known_bins(const Circle& circle) {
+  std::vector<int> bins;
+  for (int k = 0; k < circle.size(); ++k) {
+    if (circle.bins[static_cast<size_t>(k)].known()) bins.push_back(k);
+  }
+  return bins;
+}
+
+}  // namespace
+
+TEST_CASE("A point 2 m straight ahead at 1.05 m height reads 2 m in bin 0, row 9", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(Eigen::Vector3f(2.0f, 0.0f, 1.05f));
+  CHECK(known_bins(r.circle()) == std::vector<int>{0});
+  CHECK(r.circle().bins[0].range == Approx(2.0));
+  CHECK(r.circle().bins[0].point.isApprox(Eigen::Vector3f(2.0f, 0.0f, 1.05f)));
+  CHECK(r.cylinder().known_count() == 1);
+  CHECK(r.cylinder().at(9, 0).range == Approx(2.0));  // (1.05 - 0.1) / 0.1 = 9.5
+}
+
+TEST_CASE("359.9 degrees falls in bin 359 and 0.1 degrees in bin 0", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(polar(0.1, 3.0, 1.0));
+  r.add(polar(-0.1, 2.0, 1.0));
+  CHECK(known_bins(r.circle()) == std::vector<int>{0, 359});
+  CHECK(r.circle().bins[0].range == Approx(3.0).epsilon(1e-6));
+  CHECK(r.circle().bins[359].range == Approx(2.0).epsilon(1e-6));
+}
+
+TEST_CASE("Points exactly on bin edges belong to the bin above the edge", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(Eigen::Vector3f(0.0f, 2.0f, 1.0f));    // 90 degrees: left
+  r.add(Eigen::Vector3f(-2.0f, 0.0f, 1.0f));   // 180: behind
+  r.add(Eigen::Vector3f(0.0f, -2.0f, 1.0f));   // 270: right
+  r.add(Eigen::Vector3f(1.5f, 1.5f, 1.0f));    // 45 (atan2 rounding must not give 44.999...)
+  r.add(Eigen::Vector3f(3.0f, 0.0f, 1.0f));    // 0
+  CHECK(known_bins(r.circle()) == std::vector<int>{0, 45, 90, 180, 270});
+
+  // Behind with y = -0: atan2 gives -180 degrees, which is 180, not 359 or 360.
+  Rasteriser behind = at_origin();
+  behind.add(Eigen::Vector3f(-2.0f, -0.0f, 1.0f));
+  CHECK(known_bins(behind.circle()) == std::vector<int>{180});
+  // A hair clockwise of straight ahead is the last bin.
+  Rasteriser right_of_ahead = at_origin();
+  right_of_ahead.add(Eigen::Vector3f(2.0f, -1e-4f, 1.0f));
+  CHECK(known_bins(right_of_ahead.circle()) == std::vector<int>{359});
+}
+
+TEST_CASE("Only points in the obstacle band above the ground count", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(polar(10.5, 1.0, 0.05));   // ground clutter below 0.1 m
+  r.add(polar(20.5, 1.0, 2.05));   // above the band
+  r.add(polar(30.5, 1.0, 0.1));    // bottom edge: in
+  r.add(polar(40.5, 1.0, 2.0));    // top edge: in, last row
+  CHECK(known_bins(r.circle()) == std::vector<int>{30, 40});
+  CHECK(r.cylinder().at(0, 30).known());
+  CHECK(r.cylinder().at(18, 40).known());
+  CHECK(r.cylinder().known_count() == 2);
+
+  // The band is measured from the origin's ground height.
+  Rasteriser raised(RasterConfig{});
+  RasterOrigin on_a_stage;
+  on_a_stage.ground_z = 1.0;
+  raised.reset(on_a_stage);
+  raised.add(polar(10.5, 1.0, 1.05));  // 0.05 m above this ground: out
+  raised.add(polar(20.5, 1.0, 1.55));  // 0.55 m: row 4
+  CHECK(known_bins(raised.circle()) == std::vector<int>{20});
+  CHECK(raised.cylinder().at(4, 20).known());
+}
+
+TEST_CASE("Points beyond the maximum range are ignored, at it are kept", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(Eigen::Vector3f(5.01f, 0.0f, 1.0f));
+  r.add(Eigen::Vector3f(0.0f, 5.0f, 1.0f));
+  CHECK(known_bins(r.circle()) == std::vector<int>{90});
+  CHECK(r.circle().bins[90].range == 5.0f);
+}
+
+TEST_CASE("A point on the sensor's vertical axis has no azimuth and is skipped", "[rasteriser]") {
+  Rasteriser r(RasterConfig{});
+  RasterOrigin origin;
+  origin.position = Eigen::Vector3d(1.0, 2.0, 1.6);
+  r.reset(origin);
+  r.add(Eigen::Vector3f(1.0f, 2.0f, 1.0f));  // below the sensor, 1 m above the ground
+  CHECK(r.circle().known_count() == 0);
+  CHECK(r.cylinder().known_count() == 0);
+}
+
+TEST_CASE("Non-finite points are skipped", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(Eigen::Vector3f(NAN, 1.0f, 1.0f));
+  r.add(Eigen::Vector3f(2.0f, INFINITY, 1.0f));
+  r.add(Eigen::Vector3f(2.0f, 0.0f, NAN));
+  CHECK(r.circle().known_count() == 0);
+}
+
+TEST_CASE("The heading rotates the bins: ahead of the body is bin 0 whatever the yaw",
+          "[rasteriser]") {
+  Rasteriser r(RasterConfig{});
+  RasterOrigin facing_world_y;
+  facing_world_y.heading = M_PI / 2;  // body x along world +y
+  r.reset(facing_world_y);
+  r.add(Eigen::Vector3f(0.0f, 3.0f, 1.0f));   // world +y: ahead
+  r.add(Eigen::Vector3f(-2.0f, 0.0f, 1.0f));  // world -x: to the body's left
+  r.add(Eigen::Vector3f(1.0f, 0.0f, 1.0f));   // world +x: to the body's right
+  CHECK(known_bins(r.circle()) == std::vector<int>{0, 90, 270});
+  CHECK(r.circle().bins[0].range == Approx(3.0));
+
+  Rasteriser thirty(RasterConfig{});
+  RasterOrigin yawed;
+  yawed.heading = 30.0 * kDeg;
+  yawed.position = Eigen::Vector3d(1.0, -1.0, 1.5);
+  thirty.reset(yawed);
+  // World azimuth 45.5 from the origin -> 15.5 in the body frame.
+  thirty.add(polar(45.5, 2.0, 1.0) + Eigen::Vector3f(1.0f, -1.0f, 0.0f));
+  CHECK(known_bins(thirty.circle()) == std::vector<int>{15});
+  CHECK(thirty.circle().bins[15].range == Approx(2.0).epsilon(1e-6));
+}
+
+TEST_CASE("Each cell keeps the closest point; the cylinder keeps it per row", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(polar(10.5, 3.0, 0.55));  // row 4
+  r.add(polar(10.5, 2.0, 1.55));  // row 14, closer
+  r.add(polar(10.7, 2.5, 0.52));  // row 4, closer than 3 m
+  r.add(polar(10.2, 4.0, 1.58));  // row 14, farther
+  const RasterCell& bin = r.circle().bins[10];
+  CHECK(bin.range == Approx(2.0).epsilon(1e-6));
+  CHECK(bin.point.z() == Approx(1.55));
+  CHECK(r.cylinder().at(4, 10).range == Approx(2.5).epsilon(1e-6));
+  CHECK(r.cylinder().at(4, 10).point.z() == Approx(0.52));
+  CHECK(r.cylinder().at(14, 10).range == Approx(2.0).epsilon(1e-6));
+  CHECK(r.cylinder().known_count() == 2);
+}
+
+TEST_CASE("reset starts an empty raster around the new origin", "[rasteriser]") {
+  Rasteriser r = at_origin();
+  r.add(Eigen::Vector3f(2.0f, 0.0f, 1.0f));
+  RasterOrigin moved;
+  moved.position = Eigen::Vector3d(2.0, 1.0, 1.6);
+  r.reset(moved);
+  CHECK(r.circle().known_count() == 0);
+  CHECK(r.cylinder().known_count() == 0);
+  r.add(Eigen::Vector3f(2.0f, 0.0f, 1.0f));  // now 1 m to the right
+  CHECK(known_bins(r.circle()) == std::vector<int>{270});
+  CHECK(r.circle().bins[270].range == Approx(1.0));
+
+  RasterOrigin broken;
+  broken.heading = NAN;
+  CHECK_THROWS_AS(r.reset(broken), std::invalid_argument);
+  CHECK_THROWS_AS(Rasteriser(RasterConfig{360, 2.0, 0.1}), std::invalid_argument);
+}
+
+TEST_CASE("A half-degree circle splits each degree in two", "[rasteriser]") {
+  RasterConfig fine;
+  fine.azimuth_bins = 720;
+  Rasteriser r = at_origin(fine);
+  r.add(polar(10.25, 2.0, 1.0));
+  r.add(polar(10.75, 2.0, 1.0));
+  CHECK(known_bins(r.circle()) == std::vector<int>{20, 21});
+}
