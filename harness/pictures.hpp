@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Pictures a person would rather look at than CSV, drawn by gnuplot (pngcairo):
+// the circle as a top view around the listener, the cylinder unrolled (azimuth x height).
+#pragma once
+
+#include "core/raster.hpp"
+#include "core/types.hpp"
+
+#include <filesystem>
+#include <string>
+
+namespace sonomap::harness {
+
+// Top view, heading up (straight ahead is up, left is left). The estimate is a ring coloured by
+// each bin's range (grey where unknown) and its selected closest points, coloured the same; the
+// ground truth is a black outline at its range per bin.
+void plot_circle(const std::filesystem::path& png, const Circle& estimate, const Circle* truth,
+                 const RasterOrigin& origin, const RasterConfig& config, const std::string& title);
+
+// The cylinder unrolled: azimuth across (ahead in the middle, left to the left), height up,
+// coloured by range; unknown cells are left white.
+void plot_cylinder(const std::filesystem::path& png, const Cylinder& estimate,
+                   const RasterConfig& config, const std::string& title);
+
+// Runs gnuplot on a script; throws std::runtime_error with gnuplot's message if it fails.
+void run_gnuplot(const std::filesystem::path& script);
+
+}  // namespace sonomap::harness
