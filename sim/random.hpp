@@ -14,7 +14,6 @@ namespace sonomap::sim {
 enum class StreamPurpose : std::uint64_t {
   LateralJitter = 1,
   AxialNoise = 2,
-  GrazingInvalidation = 3,
   Dropout = 4,
   LocalisationNoise = 5,
   LocalisationDrift = 6,

@@ -97,6 +97,7 @@ struct NoiseSpec {
   double baseline = 0.075;           // metres, Kinect v1
   double disparity_step = 0.125;     // pixels (1/8)
   double edge_threshold = 0.1;       // metres: depth jump to a neighbour that marks an edge
+  double grazing_angle = 1.3962634015954636;  // radians (80 deg): beyond it, no return
 };
 
 struct LocalisationSpec {

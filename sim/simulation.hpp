@@ -12,6 +12,8 @@
 namespace sonomap::sim {
 
 class World;
+class DepthCamera;
+class LocalisationModel;
 
 class Simulation {
  public:
@@ -37,8 +39,8 @@ class Simulation {
  private:
   Scenario scenario_;
   std::unique_ptr<World> world_;
-  struct Localisation;
-  std::unique_ptr<Localisation> localisation_;
+  std::unique_ptr<DepthCamera> camera_;
+  std::unique_ptr<LocalisationModel> localisation_;
 };
 
 // Throws std::invalid_argument for zero / negative / non-finite intrinsics or resolution,

@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "sim/noise.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sonomap::sim {
+
+namespace {
+
+// Keeps the grazing terms finite when a surface is seen exactly edge-on.
+constexpr double kMaxTheta = M_PI / 2 - 1e-3;
+
+double incidence_angle(float cos_incidence) {
+  return std::min(std::acos(std::clamp(static_cast<double>(cos_incidence), 0.0, 1.0)), kMaxTheta);
+}
+
+RandomStream row_stream(const NoiseKey& key, StreamPurpose purpose, int row) {
+  return RandomStream({key.seed, key.sensor, key.frame, static_cast<std::uint64_t>(purpose),
+                       static_cast<std::uint64_t>(row)});
+}
+
+// Runs body(row) for every row, rows spread over TBB threads.
+template <typename Body>
+void for_each_row(int height, const Body& body) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    for (int v = rows.begin(); v < rows.end(); ++v) body(v);
+  });
+}
+
+}  // namespace
+
+double axial_sigma(double z, double theta) {
+  double sigma = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
+  if (theta > M_PI / 3) {
+    const double t = std::min(theta, kMaxTheta);
+    sigma += 0.0001 / std::sqrt(z) * t * t / ((M_PI / 2 - t) * (M_PI / 2 - t));
+  }
+  return sigma;
+}
+
+double lateral_sigma_px(double theta) {
+  const double t = std::min(theta, kMaxTheta);
+  return 0.8 + 0.035 * t / (M_PI / 2 - t);
+}
+
+DepthImage jitter_lateral(const DepthImage& in, const NoiseKey& key) {
+  DepthImage out = in;
+  for_each_row(in.height, [&](int v) {
+    RandomStream rng = row_stream(key, StreamPurpose::LateralJitter, v);
+    for (int u = 0; u < in.width; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * in.width + u;
+      const double sigma = lateral_sigma_px(incidence_angle(in.cos_incidence[p]));
+      const int su = std::clamp(u + static_cast<int>(std::lround(rng.normal(sigma))), 0, in.width - 1);
+      const int sv = std::clamp(v + static_cast<int>(std::lround(rng.normal(sigma))), 0, in.height - 1);
+      const std::size_t source = static_cast<std::size_t>(sv) * in.width + su;
+      out.z[p] = in.z[source];
+      out.cos_incidence[p] = in.cos_incidence[source];
+    }
+  });
+  return out;
+}
+
+DepthImage add_axial_noise(const DepthImage& in, const NoiseKey& key) {
+  DepthImage out = in;
+  for_each_row(in.height, [&](int v) {
+    RandomStream rng = row_stream(key, StreamPurpose::AxialNoise, v);
+    for (int u = 0; u < in.width; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * in.width + u;
+      const double z = in.z[p];
+      if (!(z > 0.0)) continue;
+      const double noisy = z + rng.normal(axial_sigma(z, incidence_angle(in.cos_incidence[p])));
+      out.z[p] = noisy > 0.0 ? static_cast<float>(noisy) : 0.0f;
+    }
+  });
+  return out;
+}
+
+DepthImage quantise_disparity(const DepthImage& in, double focal_px, double baseline, double step) {
+  DepthImage out = in;
+  const double fb = focal_px * baseline;
+  for (float& z : out.z) {
+    if (!(z > 0.0f)) continue;
+    const double steps = std::round(fb / (z * step));
+    z = steps > 0.0 ? static_cast<float>(fb / (steps * step)) : 0.0f;
+  }
+  return out;
+}
+
+DepthImage invalidate_grazing(const DepthImage& in, double max_angle) {
+  DepthImage out = in;
+  const float min_cos = static_cast<float>(std::cos(max_angle));
+  for (std::size_t p = 0; p < out.z.size(); ++p)
+    if (out.cos_incidence[p] < min_cos) out.z[p] = 0.0f;
+  return out;
+}
+
+DepthImage invalidate_edges(const DepthImage& in, const DepthImage& reference, double threshold) {
+  DepthImage out = in;
+  const int w = reference.width, h = reference.height;
+  auto depth = [&](int u, int v) {  // no surface counts as infinitely far
+    const float z = reference.z[static_cast<std::size_t>(v) * w + u];
+    return z > 0.0f ? static_cast<double>(z) : HUGE_VAL;
+  };
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const double z = depth(u, v);
+      if (z == HUGE_VAL) continue;
+      const bool edge = (u > 0 && std::abs(depth(u - 1, v) - z) > threshold) ||
+                        (u + 1 < w && std::abs(depth(u + 1, v) - z) > threshold) ||
+                        (v > 0 && std::abs(depth(u, v - 1) - z) > threshold) ||
+                        (v + 1 < h && std::abs(depth(u, v + 1) - z) > threshold);
+      if (edge) out.z[static_cast<std::size_t>(v) * w + u] = 0.0f;
+    }
+  return out;
+}
+
+DepthImage drop_out(const DepthImage& in, double p, const NoiseKey& key) {
+  DepthImage out = in;
+  if (p <= 0.0) return out;
+  for_each_row(in.height, [&](int v) {
+    RandomStream rng = row_stream(key, StreamPurpose::Dropout, v);
+    for (int u = 0; u < in.width; ++u) {
+      float& z = out.z[static_cast<std::size_t>(v) * in.width + u];
+      if (rng.uniform() < p) z = 0.0f;  // drawn for every pixel so streams stay aligned
+    }
+  });
+  return out;
+}
+
+DepthImage apply_noise(const DepthImage& truth, const NoiseSpec& spec, double focal_px, const NoiseKey& key) {
+  if (spec.model == NoiseSpec::Model::None) return truth;
+  DepthImage image = truth;
+  if (spec.lateral) image = jitter_lateral(image, key);
+  if (spec.axial) image = add_axial_noise(image, key);
+  if (spec.quantisation) image = quantise_disparity(image, focal_px, spec.baseline, spec.disparity_step);
+  if (spec.grazing_invalidation) image = invalidate_grazing(image, spec.grazing_angle);
+  if (spec.edge_invalidation) image = invalidate_edges(image, truth, spec.edge_threshold);
+  image = drop_out(image, spec.dropout, key);
+  return image;
+}
+
+}  // namespace sonomap::sim

@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "sim/world.hpp"
+
+#include "sim/primitives.hpp"
+#include "sim/trajectory.hpp"
+#include "sim/world_geometry.hpp"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace sonomap::sim {
+
+namespace {
+
+constexpr int kTile = 4;  // 4x4 pixel tiles = one rtcIntersect16 packet
+
+void throw_on_device_error(RTCDevice device, const char* what) {
+  const RTCError error = rtcGetDeviceError(device);
+  if (error != RTC_ERROR_NONE)
+    throw std::runtime_error(std::string("embree: ") + what + " failed (error " +
+                             std::to_string(static_cast<int>(error)) + ")");
+}
+
+// A scene holding one triangle geometry with `mesh` placed by `transform`.
+RTCScene make_mesh_scene(RTCDevice device, const TriangleMesh& mesh, const Eigen::Isometry3d& transform,
+                         RTCBuildQuality quality) {
+  RTCScene scene = rtcNewScene(device);
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(scene, quality);
+  if (!mesh.triangles.empty()) {
+    RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetGeometryBuildQuality(geometry, quality);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+    throw_on_device_error(device, "allocating mesh buffers");
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+      const Eigen::Vector3f v = (transform * mesh.vertices[i].cast<double>()).cast<float>();
+      std::memcpy(vertices + 3 * i, v.data(), 3 * sizeof(float));
+    }
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+      for (int c = 0; c < 3; ++c) indices[3 * i + c] = static_cast<unsigned>(mesh.triangles[i][c]);
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(scene);
+  throw_on_device_error(device, "building a scene");
+  return scene;
+}
+
+// Appends mesh b (already in the frame of a) to a.
+void append_mesh(TriangleMesh& a, const TriangleMesh& b, const Eigen::Isometry3d& a_T_b) {
+  const int offset = static_cast<int>(a.vertices.size());
+  for (const Eigen::Vector3f& v : b.vertices) a.vertices.push_back((a_T_b * v.cast<double>()).cast<float>());
+  for (const Eigen::Vector3i& t : b.triangles) a.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+}
+
+}  // namespace
+
+struct World::Impl {
+  struct Mover {
+    const MovingObject* spec = nullptr;
+    RTCScene scene = nullptr;
+    RTCGeometry instance = nullptr;
+    unsigned instance_id = RTC_INVALID_GEOMETRY_ID;
+  };
+
+  RTCDevice device = nullptr;
+  RTCScene top = nullptr;
+  RTCScene statics = nullptr;
+  std::vector<Mover> movers;
+  // World rotation of each instance by its geometry id in `top` (to bring Embree's
+  // object-space Ng into the world frame).
+  std::vector<Eigen::Matrix3f> instance_rotation;
+
+  ~Impl() {
+    for (Mover& m : movers)
+      if (m.scene) rtcReleaseScene(m.scene);
+    if (statics) rtcReleaseScene(statics);
+    if (top) rtcReleaseScene(top);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  unsigned add_instance(RTCScene child, RTCGeometry& out) {
+    out = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(out, child);
+    rtcSetGeometryTimeStepCount(out, 1);
+    set_transform(out, Eigen::Isometry3d::Identity());
+    const unsigned id = rtcAttachGeometry(top, out);
+    rtcReleaseGeometry(out);  // the top scene keeps it alive
+    if (instance_rotation.size() <= id) instance_rotation.resize(id + 1, Eigen::Matrix3f::Identity());
+    return id;
+  }
+
+  static void set_transform(RTCGeometry instance, const Eigen::Isometry3d& pose) {
+    const Eigen::Matrix<float, 3, 4> m = pose.matrix().topRows<3>().cast<float>();  // column-major
+    rtcSetGeometryTransform(instance, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, m.data());
+  }
+};
+
+World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
+  Impl& w = *impl_;
+  w.device = rtcNewDevice(nullptr);
+  if (!w.device) throw std::runtime_error("embree: could not create a device");
+  w.top = rtcNewScene(w.device);
+  rtcSetSceneFlags(w.top, RTC_SCENE_FLAG_ROBUST);
+
+  // All statics merged into one world-frame mesh, built once at high quality.
+  TriangleMesh merged;
+  for (const StaticObject& object : scenario.statics) {
+    const TriangleMesh mesh = mesh_of(object.shape, object.mesh);
+    validate(mesh);
+    append_mesh(merged, mesh, object.pose);
+  }
+  w.statics = make_mesh_scene(w.device, merged, Eigen::Isometry3d::Identity(), RTC_BUILD_QUALITY_HIGH);
+  RTCGeometry static_instance = nullptr;
+  w.add_instance(w.statics, static_instance);
+  rtcCommitGeometry(static_instance);
+
+  w.movers.reserve(scenario.movers.size());
+  for (const MovingObject& spec : scenario.movers) {
+    const TriangleMesh mesh = mesh_of(spec.shape, spec.mesh);
+    validate(mesh);
+    validate(spec.trajectory);
+    Impl::Mover m;
+    m.spec = &spec;
+    m.scene = make_mesh_scene(w.device, mesh, Eigen::Isometry3d::Identity(), RTC_BUILD_QUALITY_HIGH);
+    m.instance_id = w.add_instance(m.scene, m.instance);
+    w.movers.push_back(m);
+  }
+  set_time(0.0);
+  throw_on_device_error(w.device, "building the world");
+}
+
+World::~World() = default;
+
+void World::set_time(double t) {
+  Impl& w = *impl_;
+  for (Impl::Mover& m : w.movers) {
+    if (is_present(*m.spec, t)) {
+      const Eigen::Isometry3d pose = pose_at(m.spec->trajectory, t);
+      Impl::set_transform(m.instance, pose);
+      w.instance_rotation[m.instance_id] = pose.linear().cast<float>();
+      rtcEnableGeometry(m.instance);
+    } else {
+      rtcDisableGeometry(m.instance);
+    }
+    rtcCommitGeometry(m.instance);
+  }
+  rtcCommitScene(w.top);
+}
+
+RayHits World::cast(const PinholeRays& rays) const {
+  const Impl& w = *impl_;
+  RayHits hits;
+  hits.width = rays.width;
+  hits.height = rays.height;
+  const std::size_t n = static_cast<std::size_t>(rays.width) * rays.height;
+  hits.z.assign(n, std::numeric_limits<float>::infinity());
+  hits.normal_world.assign(n, Eigen::Vector3f::Zero());
+
+  const Eigen::Matrix3f world_R_camera = rays.world_T_camera.linear().cast<float>();
+  const Eigen::Vector3f origin = rays.world_T_camera.translation().cast<float>();
+  const int tiles_x = (rays.width + kTile - 1) / kTile;
+  const int tiles_y = (rays.height + kTile - 1) / kTile;
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& range) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    RTCRayHit16 packet;
+    int valid[16];
+    for (int ty = range.begin(); ty < range.end(); ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        for (int i = 0; i < 16; ++i) {
+          const int u = tx * kTile + i % kTile;
+          const int v = ty * kTile + i / kTile;
+          valid[i] = (u < rays.width && v < rays.height) ? -1 : 0;
+          const Eigen::Vector3f d_camera(static_cast<float>((u - rays.cx) / rays.fx),
+                                         static_cast<float>((v - rays.cy) / rays.fy), 1.0f);
+          const Eigen::Vector3f d = world_R_camera * d_camera;
+          packet.ray.org_x[i] = origin.x();
+          packet.ray.org_y[i] = origin.y();
+          packet.ray.org_z[i] = origin.z();
+          packet.ray.dir_x[i] = d.x();
+          packet.ray.dir_y[i] = d.y();
+          packet.ray.dir_z[i] = d.z();
+          packet.ray.tnear[i] = 0.0f;
+          packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
+          packet.ray.time[i] = 0.0f;
+          packet.ray.mask[i] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on: 0 would hit nothing
+          packet.ray.id[i] = static_cast<unsigned>(i);
+          packet.ray.flags[i] = 0;
+          packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+          packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, w.top, &context, &packet);
+        for (int i = 0; i < 16; ++i) {
+          if (!valid[i] || packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+          const int u = tx * kTile + i % kTile;
+          const int v = ty * kTile + i / kTile;
+          const std::size_t p = static_cast<std::size_t>(v) * rays.width + u;
+          hits.z[p] = packet.ray.tfar[i];
+          const Eigen::Vector3f ng(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
+          hits.normal_world[p] = (w.instance_rotation[packet.hit.instID[0][i]] * ng).normalized();
+        }
+      }
+    }
+  });
+  return hits;
+}
+
+}  // namespace sonomap::sim
