@@ -1,0 +1,402 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/run.hpp"
+
+#include "core/rasteriser.hpp"
+#include "harness/errors.hpp"
+#include "harness/ground_truth.hpp"
+#include "harness/interrupt.hpp"
+#include "harness/mapper_factory.hpp"
+#include "harness/metrics.hpp"
+#include "harness/output.hpp"
+#include "harness/pictures.hpp"
+#include "harness/progress.hpp"
+#include "harness/scenario_yaml.hpp"
+#include "sim/simulation.hpp"
+#include "sim/world_geometry.hpp"
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace sonomap::harness {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Run keys (everything that is not part of the scenario file).
+struct RunSettings {
+  RasterConfig raster;
+  MetricsConfig metrics;
+  bool ghost_tolerance_set = false;
+  std::vector<Setting> mapper;
+};
+
+bool is_run_key(const std::string& key) {
+  for (const char* prefix : {"mapper.", "raster.", "metrics."})
+    if (key.rfind(prefix, 0) == 0) return true;
+  return false;
+}
+
+double parse_number(const Setting& s) {
+  try {
+    size_t used = 0;
+    const double v = std::stod(s.value, &used);
+    if (used == s.value.size() && std::isfinite(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw InputError(s.source + ": key '" + s.key + "': expected a number, got '" + s.value + "'");
+}
+
+void apply_run_setting(RunSettings& settings, const Setting& s) {
+  const std::string& k = s.key;
+  if (k.rfind("mapper.", 0) == 0) {
+    settings.mapper.push_back({k.substr(7), s.value, s.source});
+    return;
+  }
+  std::map<std::string, double*> numbers = {
+      {"raster.band_min", &settings.raster.band_min},
+      {"raster.band_max", &settings.raster.band_max},
+      {"raster.row_height", &settings.raster.row_height},
+      {"raster.max_range", &settings.raster.max_range},
+      {"metrics.ghost_tolerance", &settings.metrics.ghost_tolerance},
+  };
+  if (auto it = numbers.find(k); it != numbers.end()) {
+    *it->second = parse_number(s);
+    if (k == "metrics.ghost_tolerance") settings.ghost_tolerance_set = true;
+    return;
+  }
+  if (k == "raster.azimuth_bins") {
+    const double v = parse_number(s);
+    if (v != std::floor(v) || v < 1 || v > 36000)
+      throw InputError(s.source + ": key '" + k + "': expected a whole number in [1, 36000]");
+    settings.raster.azimuth_bins = static_cast<int>(v);
+    return;
+  }
+  throw InputError(s.source + ": unknown key '" + k +
+                   "' (run keys: mapper.*, raster.band_min, raster.band_max, raster.row_height, "
+                   "raster.max_range, raster.azimuth_bins, metrics.ghost_tolerance)");
+}
+
+// Splits "key=value" overrides into scenario overrides and run settings.
+void split_overrides(const std::vector<std::string>& overrides, std::vector<std::string>& scenario,
+                     RunSettings& settings) {
+  for (const std::string& o : overrides) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError("--set " + o + ": expected key=value");
+    const std::string key = o.substr(0, eq);
+    if (is_run_key(key))
+      apply_run_setting(settings, {key, o.substr(eq + 1), "--set " + o});
+    else
+      scenario.push_back(o);
+  }
+  try {
+    settings.raster.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--set raster.*: ") + e.what());
+  }
+}
+
+// A range for CSV: empty when unknown; fixed precision so reruns compare byte for byte.
+std::string csv_range(const RasterCell& cell) {
+  return cell.known() ? fmt::format("{:.6f}", cell.range) : std::string();
+}
+
+std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v) : ""; }
+
+json metrics_json(const RasterMetrics& m) {
+  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return json{{"coverage", num(m.coverage)}, {"rmse", num(m.rmse)},
+              {"ghosts", m.ghosts},          {"known_in_both", m.known_in_both},
+              {"truth_occupied", m.truth_occupied}, {"estimate_known", m.estimate_known},
+              {"cells", m.cells}};
+}
+
+// Mean of a metric over frames where it is defined.
+struct MetricSeries {
+  std::vector<RasterMetrics> frames;
+  json summary() const {
+    double cov = 0, rmse = 0, ghosts = 0;
+    int n_cov = 0, n_rmse = 0;
+    for (const auto& m : frames) {
+      if (std::isfinite(m.coverage)) cov += m.coverage, ++n_cov;
+      if (std::isfinite(m.rmse)) rmse += m.rmse, ++n_rmse;
+      ghosts += m.ghosts;
+    }
+    json mean{{"coverage", n_cov ? json(cov / n_cov) : json(nullptr)},
+              {"rmse", n_rmse ? json(rmse / n_rmse) : json(nullptr)},
+              {"ghosts", frames.empty() ? json(nullptr) : json(ghosts / frames.size())}};
+    return json{{"final", frames.empty() ? json(nullptr) : metrics_json(frames.back())},
+                {"mean", mean}};
+  }
+};
+
+bool chosen(const std::vector<int>& list, int frame, int last_evaluated) {
+  if (list.empty()) return frame == last_evaluated;
+  return std::find(list.begin(), list.end(), frame) != list.end();
+}
+
+// FNV-1a over the canonical JSON of the configuration: a short, stable config hash.
+std::string config_hash(const json& config) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : config.dump()) h = (h ^ c) * 1099511628211ull;
+  return fmt::format("{:016x}", h);
+}
+
+std::string pose_csv(const Eigen::Isometry3d& world_T_body) {
+  const Eigen::Vector3d p = world_T_body.translation();
+  return fmt::format("{:.6f},{:.6f},{:.6f},{:.4f}", p.x(), p.y(), p.z(),
+                     heading_of(world_T_body) * 180.0 / M_PI);
+}
+
+}  // namespace
+
+RunOutcome run_scenario(const RunOptions& options) {
+  if (options.frames < 0) throw InputError("--frames must be positive, got " + std::to_string(options.frames));
+  if (options.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(options.every));
+
+  RunSettings settings;
+  std::vector<std::string> scenario_overrides;
+  split_overrides(options.overrides, scenario_overrides, settings);
+  if (options.frames > 0) scenario_overrides.push_back("frames=" + std::to_string(options.frames));
+  if (options.seed) scenario_overrides.push_back("seed=" + std::to_string(*options.seed));
+  sim::Scenario scenario = load_scenario(options.scenario, scenario_overrides);
+
+  auto mapper = make_mapper(options.mapper, options.voxel, settings.mapper);
+  if (!settings.ghost_tolerance_set) {
+    // conventions.md: a ghost is more than 2 voxels closer than the truth.
+    for (const auto& [key, value] : mapper->config_entries())
+      if (key == "global_voxel" || key == "voxel") settings.metrics.ghost_tolerance = 2.0 * std::stod(value);
+  }
+
+  std::unique_ptr<sim::Simulation> simulation;
+  try {
+    simulation = std::make_unique<sim::Simulation>(scenario);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(options.scenario.string() + ": " + e.what());
+  }
+
+  StagedDirectory staged(options.out);
+  const fs::path dir = staged.path();
+  const auto wants = [](const std::vector<int>& frames) {
+    return frames.empty() || std::any_of(frames.begin(), frames.end(), [](int f) { return f >= 0; });
+  };
+  if (wants(options.picture_frames)) fs::create_directory(dir / "pictures");
+  if (wants(options.sweep_frames)) fs::create_directory(dir / "sweeps");
+
+  std::ofstream frames_csv(dir / "frames.csv"), timings_csv(dir / "timings.csv");
+  std::ofstream circle_csv, cylinder_csv;
+  frames_csv << "frame,time,x,y,z,heading_deg,"
+                "circle_coverage,circle_rmse,circle_ghosts,circle_known,"
+                "cylinder_coverage,cylinder_rmse,cylinder_ghosts,cylinder_known\n";
+  if (options.write_rasters) {
+    circle_csv.open(dir / "circle.csv");
+    cylinder_csv.open(dir / "cylinder.csv");
+    circle_csv << "frame,bin,estimate,truth\n";
+    cylinder_csv << "frame,row,bin,estimate,truth\n";
+  }
+
+  const int frame_count = simulation->frame_count();
+  const int last_evaluated = frame_count - 1;
+  Rasteriser rasteriser(settings.raster);
+  std::vector<Eigen::Vector3f> surface;
+  MetricSeries circle_series, cylinder_series;
+  std::vector<std::string> timing_columns;
+  std::map<std::string, std::vector<double>> timing_samples;
+  Progress progress("run " + scenario.name, frame_count, options.quiet);
+
+  for (int i = 0; i < frame_count; ++i) {
+    throw_if_interrupted();
+    std::vector<std::pair<std::string, double>> times;
+    auto t0 = Clock::now();
+    const Frame frame = simulation->render(i);
+    times.emplace_back("render", ms_since(t0));
+
+    t0 = Clock::now();
+    try {
+      mapper->integrate(frame);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("frame {} (t = {:.3f} s): {}", i, frame.time, e.what()));
+    }
+    times.emplace_back("integrate", ms_since(t0));
+    for (const auto& stage : mapper->last_stage_times().stages)
+      times.emplace_back("map." + stage.first, stage.second);
+
+    const bool evaluate = (i % options.every == 0) || i == last_evaluated;
+    if (evaluate) {
+      t0 = Clock::now();
+      const RasterOrigin origin = raster_origin(frame.world_T_body, scenario.ground_z);
+      surface.clear();
+      mapper->surface_points(origin.position, settings.raster.max_range, surface);
+      rasteriser.reset(origin);
+      rasteriser.add(surface);
+      times.emplace_back("raster", ms_since(t0));
+
+      t0 = Clock::now();
+      const RasterOrigin true_origin = raster_origin(frame.world_T_body_true, scenario.ground_z);
+      const GroundTruthRasters truth = ground_truth_rasters(
+          sim::world_triangles(scenario, frame.time), true_origin, settings.raster);
+      times.emplace_back("truth", ms_since(t0));
+
+      const RasterMetrics mc = compare(rasteriser.circle(), truth.circle, settings.metrics);
+      const RasterMetrics my = compare(rasteriser.cylinder(), truth.cylinder, settings.metrics);
+      circle_series.frames.push_back(mc);
+      cylinder_series.frames.push_back(my);
+      frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ','
+                 << pose_csv(frame.world_T_body_true) << ',' << csv_number(mc.coverage) << ','
+                 << csv_number(mc.rmse) << ',' << mc.ghosts << ',' << mc.estimate_known << ','
+                 << csv_number(my.coverage) << ',' << csv_number(my.rmse) << ',' << my.ghosts
+                 << ',' << my.estimate_known << '\n';
+
+      if (options.write_rasters) {
+        const Circle& c = rasteriser.circle();
+        for (int k = 0; k < c.size(); ++k)
+          circle_csv << i << ',' << k << ',' << csv_range(c.bins[k]) << ','
+                     << csv_range(truth.circle.bins[k]) << '\n';
+        const Cylinder& y = rasteriser.cylinder();
+        for (int r = 0; r < y.rows; ++r)
+          for (int k = 0; k < y.azimuth_bins; ++k)
+            cylinder_csv << i << ',' << r << ',' << k << ',' << csv_range(y.at(r, k)) << ','
+                         << csv_range(truth.cylinder.at(r, k)) << '\n';
+      }
+      if (chosen(options.picture_frames, i, last_evaluated)) {
+        const std::string stem = fmt::format("frame_{:06d}", i);
+        plot_circle(dir / "pictures" / (stem + "_circle.png"), rasteriser.circle(), &truth.circle,
+                    origin, settings.raster,
+                    fmt::format("{}: {} circle, frame {} (t = {:.2f} s)", scenario.name,
+                                mapper->name(), i, frame.time));
+        plot_cylinder(dir / "pictures" / (stem + "_cylinder.png"), rasteriser.cylinder(),
+                      settings.raster,
+                      fmt::format("{}: {} cylinder, frame {}", scenario.name, mapper->name(), i));
+      }
+    }
+
+    if (timing_columns.empty()) {
+      for (const auto& t : times) timing_columns.push_back(t.first);
+      timings_csv << "frame";
+      for (const auto& name : timing_columns) timings_csv << ',' << name << "_ms";
+      timings_csv << '\n';
+    }
+    timings_csv << i;
+    for (const auto& name : timing_columns) {
+      auto it = std::find_if(times.begin(), times.end(), [&](auto& t) { return t.first == name; });
+      timings_csv << ',' << (it != times.end() ? fmt::format("{:.3f}", it->second) : "");
+      if (it != times.end()) timing_samples[name].push_back(it->second);
+    }
+    timings_csv << '\n';
+    progress.update(i + 1);
+  }
+  progress.finish();
+
+  json config{{"mapper", mapper->name()}, {"mapper_config", json::object()},
+              {"raster", {{"azimuth_bins", settings.raster.azimuth_bins},
+                          {"band_min", settings.raster.band_min},
+                          {"band_max", settings.raster.band_max},
+                          {"row_height", settings.raster.row_height},
+                          {"max_range", settings.raster.max_range}}},
+              {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance}}},
+              {"frames", frame_count}, {"every", options.every}, {"seed", scenario.seed},
+              {"overrides", options.overrides}};
+  for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;
+
+  json summary{{"scenario", {{"name", scenario.name}, {"file", options.scenario.string()}}},
+               {"seed", scenario.seed},
+               {"code_version", code_version()},
+               {"ground_truth", true},
+               {"config", config},
+               {"config_hash", config_hash(config)},
+               {"evaluated_frames", circle_series.frames.size()},
+               {"metrics", {{"circle", circle_series.summary()},
+                            {"cylinder", cylinder_series.summary()}}}};
+
+  json timings = json::object();
+  for (auto& [name, samples] : timing_samples) {
+    std::sort(samples.begin(), samples.end());
+    timings[name] = {{"median_ms", samples[samples.size() / 2]}, {"samples", samples.size()}};
+  }
+
+  for (std::ofstream* f : {&frames_csv, &timings_csv, &circle_csv, &cylinder_csv})
+    if (f->is_open()) {
+      f->close();
+      if (f->fail()) throw std::runtime_error("writing the result files in " + dir.string() + " failed");
+    }
+  {
+    std::ofstream out(dir / "summary.json");
+    out << summary.dump(2) << '\n';
+  }
+  {
+    std::ofstream out(dir / "timings.json");
+    out << timings.dump(2) << '\n';
+  }
+  staged.commit();
+  return RunOutcome{options.out, summary};
+}
+
+std::string summary_screen(const RunOutcome& outcome) {
+  const json& s = outcome.summary;
+  auto metric = [&](const char* raster, const char* which, const char* name) -> std::string {
+    const json& v = s["metrics"][raster][which];
+    if (v.is_null() || v[name].is_null()) return "-";
+    if (std::string(name) == "coverage") return fmt::format("{:.1f}%", 100.0 * v[name].get<double>());
+    if (std::string(name) == "rmse") return fmt::format("{:.3f} m", v[name].get<double>());
+    return fmt::format("{}", v[name].dump());
+  };
+  std::string text = fmt::format("sonomap run: {} with {} ({} frames, seed {})\n",
+                                 s["scenario"]["name"].get<std::string>(),
+                                 s["config"]["mapper"].get<std::string>(),
+                                 s["config"]["frames"].get<int>(), s["seed"].get<std::uint64_t>());
+  text += fmt::format("  {:<10} {:>10} {:>10} {:>8} {:>12} {:>10}\n", "raster", "coverage",
+                      "RMSE", "ghosts", "mean cov.", "mean RMSE");
+  for (const char* raster : {"circle", "cylinder"})
+    text += fmt::format("  {:<10} {:>10} {:>10} {:>8} {:>12} {:>10}\n", raster,
+                        metric(raster, "final", "coverage"), metric(raster, "final", "rmse"),
+                        metric(raster, "final", "ghosts"), metric(raster, "mean", "coverage"),
+                        metric(raster, "mean", "rmse"));
+  text += fmt::format("  results: {}\n", outcome.dir.string());
+  return text;
+}
+
+void add_run_command(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Run a scenario through the whole chain (sensor, mapper, rasters, ground truth, "
+             "metrics, pictures, sweeps) and write one result directory");
+  cmd->add_option("scenario", options->scenario, "Scenario YAML file")->required();
+  cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
+  cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--every", options->every,
+                  "Evaluate rasters, truth and metrics every K-th frame (and the last)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--mapper", options->mapper, "Mapper: vdb_gpdf, tsdf or depth_only")
+      ->capture_default_str();
+  cmd->add_option("--voxel", options->voxel, "Global voxel size in metres (default: the mapper's)");
+  cmd->add_option("--seed", options->seed, "Run seed (overrides the scenario's)");
+  cmd->add_option("--set", options->overrides,
+                  "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*)");
+  cmd->add_option("--pictures", options->picture_frames,
+                  "Frames to draw (default: the last; -1: none)");
+  cmd->add_option("--sweeps", options->sweep_frames,
+                  "Frames to sonify as a WAV sweep (default: the last; -1: none)");
+  cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
+  cmd->callback([options, &global] {
+    options->quiet = global.quiet;
+    install_interrupt_handler();
+    const RunOutcome outcome = run_scenario(*options);
+    if (!global.quiet) std::fputs(summary_screen(outcome).c_str(), stdout);
+  });
+}
+
+}  // namespace sonomap::harness
