@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Binaural impulse responses held in memory: a measured HRIR set (any directions) used to
+// synthesise rooms, and a BRIR set on the paper's horizontal grid (azimuth x distance) used by
+// the sweep. Directions follow SOFA and conventions.md: x front, y left, z up, azimuth
+// counter-clockwise from the front. Files are read and written by harness/sofa_io.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace sonomap::audio {
+
+enum class Ear { Left = 0, Right = 1 };
+
+// One impulse response per ear, equal lengths.
+struct BinauralIr {
+  std::vector<float> left;
+  std::vector<float> right;
+  const std::vector<float>& ear(Ear e) const { return e == Ear::Left ? left : right; }
+};
+
+// A measured free-field HRIR set: one binaural IR per direction.
+struct HrirSet {
+  double sample_rate = 0.0;
+  std::vector<Eigen::Vector3d> directions;  // unit vectors in the head frame
+  std::vector<BinauralIr> irs;              // irs[i] measured from directions[i]
+  // Index of the measured direction closest in angle to `direction` (any length > 0).
+  size_t nearest(const Eigen::Vector3d& direction) const;
+  // Throws std::invalid_argument unless non-empty, consistent and finite.
+  void validate() const;
+};
+
+// The paper's BRIR grid: azimuth every 3 degrees over -177..180, distances 0.4..4.0 m by 0.4 m.
+struct BrirGrid {
+  std::vector<double> azimuths_deg;
+  std::vector<double> distances_m;
+  static BrirGrid paper();
+};
+
+// BRIRs on a grid; irs[d * azimuths + a] is the pair for distances_m[d], azimuths_deg[a].
+// No interpolation anywhere: lookups snap to the nearest measured azimuth and distance.
+class BrirSet {
+ public:
+  BrirSet() = default;
+  BrirSet(double sample_rate, BrirGrid grid, std::vector<BinauralIr> irs);
+
+  double sample_rate() const { return sample_rate_; }
+  const BrirGrid& grid() const { return grid_; }
+  size_t azimuth_count() const { return grid_.azimuths_deg.size(); }
+  size_t distance_count() const { return grid_.distances_m.size(); }
+  size_t ir_length() const { return ir_length_; }
+  bool empty() const { return irs_.empty(); }
+
+  size_t nearest_azimuth(double azimuth_deg) const;  // circular distance, any angle
+  size_t nearest_distance(double metres) const;
+  const BinauralIr& at(size_t distance_index, size_t azimuth_index) const;
+
+ private:
+  double sample_rate_ = 0.0;
+  BrirGrid grid_;
+  std::vector<BinauralIr> irs_;
+  size_t ir_length_ = 0;
+};
+
+// Angle difference a - b wrapped to (-180, 180].
+double wrap_degrees_180(double degrees);
+
+}  // namespace sonomap::audio

@@ -1,0 +1,298 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "audio/brir_synth.hpp"
+
+#include "audio/fft.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <tbb/parallel_for.h>
+
+namespace sonomap::audio {
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+// 60 dB of decay: energy falls by 10^-6 = exp(-13.8155) over one RT60.
+constexpr double kLn1e3 = 6.907755278982137;
+constexpr int kFractionalTaps = 16;    // windowed-sinc fractional delay
+constexpr double kTailFadeS = 0.005;   // tail fade-in at the mixing time
+}  // namespace
+
+double ShoeboxRoom::volume() const {
+  const Eigen::Vector3d s = size();
+  return s.x() * s.y() * s.z();
+}
+
+double ShoeboxRoom::surface() const {
+  const Eigen::Vector3d s = size();
+  return 2.0 * (s.x() * s.y() + s.x() * s.z() + s.y() * s.z());
+}
+
+// 0.161 s/m = 24 ln(10) / c at c = 343 m/s.
+static constexpr double kSabine = 0.161;
+
+double sabine_rt60(const ShoeboxRoom& room, double absorption) {
+  return kSabine * room.volume() / (room.surface() * absorption);
+}
+double sabine_absorption(const ShoeboxRoom& room, double rt60) {
+  return kSabine * room.volume() / (room.surface() * rt60);
+}
+double eyring_rt60(const ShoeboxRoom& room, double absorption) {
+  return kSabine * room.volume() / (-room.surface() * std::log(1.0 - absorption));
+}
+double eyring_absorption(const ShoeboxRoom& room, double rt60) {
+  return 1.0 - std::exp(-kSabine * room.volume() / (room.surface() * rt60));
+}
+
+const std::vector<double>& octave_band_centres() {
+  static const std::vector<double> centres{125, 250, 500, 1000, 2000, 4000, 8000};
+  return centres;
+}
+
+static void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("BRIR synthesis: " + what);
+}
+
+Eigen::Vector3d listener_position(const BrirSynthConfig& c) {
+  if (!c.listener.hasNaN()) return c.listener;
+  const Eigen::Vector3d centre = 0.5 * (c.room.min_corner + c.room.max_corner);
+  const double height = std::min(1.5, 0.5 * c.room.size().z());
+  return {centre.x(), centre.y(), c.room.min_corner.z() + height};
+}
+
+void validate(const BrirSynthConfig& c) {
+  const Eigen::Vector3d s = c.room.size();
+  require(c.room.min_corner.allFinite() && c.room.max_corner.allFinite() && (s.array() > 0.1).all(),
+          "room must be finite and larger than 0.1 m on every axis");
+  const Eigen::Vector3d l = listener_position(c);
+  require(l.allFinite() && (l.array() > c.room.min_corner.array()).all() &&
+              (l.array() < c.room.max_corner.array()).all(),
+          "listener must be inside the room");
+  require(std::isfinite(c.rt60) && c.rt60 > 0.01 && c.rt60 < 20.0,
+          "rt60 must be in (0.01, 20) s, got " + std::to_string(c.rt60));
+  require(c.band_rt60.empty() || c.band_rt60.size() == octave_band_centres().size(),
+          "band_rt60 needs one value per octave band (7)");
+  for (double t : c.band_rt60)
+    require(std::isfinite(t) && t > 0.01 && t < 20.0, "band rt60 must be in (0.01, 20) s");
+  require(c.max_order >= 0 && c.max_order <= 30, "max_order must be in [0, 30]");
+  require(std::isfinite(c.sample_rate) && c.sample_rate >= 8000 && c.sample_rate <= 384000,
+          "sample rate must be in [8000, 384000] Hz");
+  require(std::isfinite(c.length_s) && c.length_s >= 0.0 && c.length_s <= 20.0,
+          "length must be in [0, 20] s");
+  require(std::isfinite(c.speed_of_sound) && c.speed_of_sound > 100.0, "speed of sound");
+  require(std::isfinite(c.wall_margin) && c.wall_margin >= 0.0, "wall margin must be >= 0");
+  require(std::isfinite(c.listener_heading_deg), "listener heading must be finite");
+  // With Eyring, a 60 dB decay shorter than the room allows means absorption >= 1.
+  require(eyring_absorption(c.room, c.rt60) < 0.999,
+          "rt60 " + std::to_string(c.rt60) + " s is too short for this room");
+}
+
+namespace {
+
+// Uniform noise of unit variance from our own stream (portable across standard libraries).
+std::vector<float> unit_noise(size_t n, uint64_t seed, uint64_t stream) {
+  std::seed_seq seq{seed, stream};
+  std::mt19937_64 rng(seq);
+  std::vector<float> out(n);
+  const double scale = std::sqrt(3.0);
+  for (auto& x : out) {
+    const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;  // [0, 1)
+    x = static_cast<float>((2.0 * u - 1.0) * scale);
+  }
+  return out;
+}
+
+// Triangular weights in log frequency between neighbouring band centres: they sum to one.
+double band_weight(double f, size_t band) {
+  const auto& c = octave_band_centres();
+  const double x = std::log2(std::max(f, 1.0));
+  const double centre = std::log2(c[band]);
+  if (band == 0 && x <= centre) return 1.0;
+  if (band + 1 == c.size() && x >= centre) return 1.0;
+  return std::max(0.0, 1.0 - std::abs(x - centre));  // octave spacing: neighbours 1 apart
+}
+
+// Decaying noise of `length` samples: each octave band decays with its own RT60.
+std::vector<float> decaying_noise(size_t length, double fs, const std::vector<double>& band_rt60,
+                                  uint64_t seed, uint64_t stream) {
+  std::vector<float> noise = unit_noise(length, seed, stream);
+  const bool uniform = std::all_of(band_rt60.begin(), band_rt60.end(),
+                                   [&](double t) { return t == band_rt60.front(); });
+  std::vector<float> out(length, 0.0f);
+  if (uniform) {
+    for (size_t i = 0; i < length; ++i)
+      out[i] = noise[i] * static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60.front()));
+    return out;
+  }
+  const RealFft fft(next_power_of_two(length) * 2);
+  AlignedSamples time(fft.size(), 0.0f);
+  std::copy(noise.begin(), noise.end(), time.begin());
+  Spectrum spectrum(fft.bins()), band(fft.bins());
+  fft.forward(time.data(), spectrum.data());
+  for (size_t b = 0; b < band_rt60.size(); ++b) {
+    for (size_t k = 0; k < fft.bins(); ++k)
+      band[k] = spectrum[k] * static_cast<float>(band_weight(k * fs / fft.size(), b));
+    fft.inverse(band.data(), time.data());
+    for (size_t i = 0; i < length; ++i)
+      out[i] += time[i] / fft.size() *
+                static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60[b]));
+  }
+  return out;
+}
+
+// One axis of the image lattice: coordinate of the image and its number of reflections.
+struct AxisImage {
+  double coordinate;
+  int reflections;
+};
+
+std::vector<AxisImage> axis_images(double source, double lo, double hi, int max_order) {
+  // Allen & Berkley: x = (1 - 2q) x' + 2 n L, reflections |n - q| + |n| (walls at 0 and L).
+  const double length = hi - lo;
+  const double x = source - lo;
+  std::vector<AxisImage> out;
+  for (int n = -max_order - 1; n <= max_order + 1; ++n)
+    for (int q = 0; q <= 1; ++q) {
+      const int count = std::abs(n - q) + std::abs(n);
+      if (count <= max_order + 1) out.push_back({lo + (1 - 2 * q) * x + 2.0 * n * length, count});
+    }
+  return out;
+}
+
+}  // namespace
+
+BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
+    : hrirs_(std::move(hrirs)), config_(std::move(config)) {
+  validate(config_);
+  hrirs_.validate();
+  if (std::abs(hrirs_.sample_rate - config_.sample_rate) > 1e-6)
+    throw std::invalid_argument("BRIR synthesis: HRIR rate " + std::to_string(hrirs_.sample_rate) +
+                                " Hz differs from the output rate " +
+                                std::to_string(config_.sample_rate) + " Hz (resample first)");
+  listener_ = listener_position(config_);
+  absorption_ = eyring_absorption(config_.room, config_.rt60);
+  std::vector<double> band_rt60 = config_.band_rt60;
+  if (band_rt60.empty()) band_rt60.assign(octave_band_centres().size(), config_.rt60);
+  const double longest = *std::max_element(band_rt60.begin(), band_rt60.end());
+  const double seconds = config_.length_s > 0.0 ? config_.length_s : longest;
+  length_ = std::max<size_t>(static_cast<size_t>(std::ceil(seconds * config_.sample_rate)),
+                             hrirs_.irs.front().left.size() + kFractionalTaps);
+  if (config_.late_tail) {
+    // Diffuse-field level: image sources arrive at 4 pi c^3 t^2 / V per second with energy
+    // E_hrir / (c t)^2 each, i.e. 4 pi c E_hrir / V per second, decaying by the RT60.
+    double hrir_energy = 0.0;
+    for (const auto& ir : hrirs_.irs)
+      for (size_t i = 0; i < ir.left.size(); ++i)
+        hrir_energy += 0.5 * (double(ir.left[i]) * ir.left[i] + double(ir.right[i]) * ir.right[i]);
+    hrir_energy /= hrirs_.irs.size();
+    const double c = config_.speed_of_sound;
+    const float level = static_cast<float>(
+        std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate)));
+    tail_.left = decaying_noise(length_, config_.sample_rate, band_rt60, config_.seed, 0);
+    tail_.right = decaying_noise(length_, config_.sample_rate, band_rt60, config_.seed, 1);
+    for (auto& x : tail_.left) x *= level;
+    for (auto& x : tail_.right) x *= level;
+  }
+}
+
+BinauralIr BrirSynthesizer::synthesize(double azimuth_deg, double distance_m) const {
+  if (!std::isfinite(azimuth_deg) || !std::isfinite(distance_m) || distance_m <= 0.05)
+    throw std::invalid_argument("BRIR synthesis: source azimuth/distance must be finite, > 0.05 m");
+  const double heading = config_.listener_heading_deg * kPi / 180.0;
+  const double world_angle = heading + azimuth_deg * kPi / 180.0;
+  const Eigen::Vector3d source =
+      listener_ + distance_m * Eigen::Vector3d(std::cos(world_angle), std::sin(world_angle), 0.0);
+  // The paper's grid reaches 4 m in every direction; a source beyond a wall pushes that wall
+  // out to just behind it, so the direct sound always arrives first.
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(config_.wall_margin);
+  const Eigen::Vector3d lo = config_.room.min_corner.cwiseMin(source - margin);
+  const Eigen::Vector3d hi = config_.room.max_corner.cwiseMax(source + margin);
+
+  const int order = config_.max_order;
+  std::vector<AxisImage> axes[3];
+  for (int a = 0; a < 3; ++a) axes[a] = axis_images(source[a], lo[a], hi[a], order);
+
+  struct Image {
+    Eigen::Vector3d offset;
+    int reflections;
+  };
+  std::vector<Image> images;
+  double mixing_distance = std::numeric_limits<double>::infinity();
+  for (const auto& ix : axes[0])
+    for (const auto& iy : axes[1])
+      for (const auto& iz : axes[2]) {
+        const int count = ix.reflections + iy.reflections + iz.reflections;
+        const Eigen::Vector3d offset =
+            Eigen::Vector3d(ix.coordinate, iy.coordinate, iz.coordinate) - listener_;
+        if (count <= order)
+          images.push_back({offset, count});
+        else if (count == order + 1)
+          mixing_distance = std::min(mixing_distance, offset.norm());
+      }
+  // Up to the mixing distance every image of the lattice is present; later the tail takes over.
+  const bool tail = config_.late_tail;
+
+  const double fs = config_.sample_rate, c = config_.speed_of_sound;
+  const double beta = std::sqrt(1.0 - absorption_);  // pressure reflection coefficient
+  const double cos_h = std::cos(heading), sin_h = std::sin(heading);
+  BinauralIr out{std::vector<float>(length_, 0.0f), std::vector<float>(length_, 0.0f)};
+  float kernel[kFractionalTaps];
+  for (const Image& image : images) {
+    const double r = std::max(image.offset.norm(), 0.05);
+    if (tail && r >= mixing_distance) continue;
+    // Arrival direction in the head frame: rotate the world offset by -heading about z.
+    const Eigen::Vector3d head(cos_h * image.offset.x() + sin_h * image.offset.y(),
+                               -sin_h * image.offset.x() + cos_h * image.offset.y(),
+                               image.offset.z());
+    const BinauralIr& hrir = hrirs_.irs[hrirs_.nearest(head)];
+    const double gain = std::pow(beta, image.reflections) / r;
+    const double delay = r / c * fs;
+    const long whole = static_cast<long>(std::floor(delay));
+    const double frac = delay - whole;
+    // Hann-windowed sinc centred on the fractional delay, normalised to unit DC gain.
+    double sum = 0.0;
+    for (int k = 0; k < kFractionalTaps; ++k) {
+      const double x = (k - (kFractionalTaps / 2 - 1)) - frac;
+      const double sinc = std::abs(x) < 1e-12 ? 1.0 : std::sin(kPi * x) / (kPi * x);
+      const double window = 0.5 * (1.0 + std::cos(kPi * x / (kFractionalTaps / 2 + 0.5)));
+      kernel[k] = static_cast<float>(sinc * window);
+      sum += kernel[k];
+    }
+    for (auto& k : kernel) k = static_cast<float>(k / sum * gain);
+    const long start = whole - (kFractionalTaps / 2 - 1);
+    const size_t n = hrir.left.size();
+    for (int k = 0; k < kFractionalTaps; ++k) {
+      for (size_t m = 0; m < n; ++m) {
+        const long i = start + k + static_cast<long>(m);
+        if (i < 0 || i >= static_cast<long>(length_)) continue;
+        out.left[i] += kernel[k] * hrir.left[m];
+        out.right[i] += kernel[k] * hrir.right[m];
+      }
+    }
+  }
+  if (tail && std::isfinite(mixing_distance)) {
+    const size_t start = static_cast<size_t>(std::ceil(mixing_distance / c * fs));
+    const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * fs));
+    for (size_t i = start; i < length_; ++i) {
+      const double x = std::min(1.0, double(i - start) / fade);
+      const float w = static_cast<float>(0.5 - 0.5 * std::cos(kPi * x));
+      out.left[i] += w * tail_.left[i];
+      out.right[i] += w * tail_.right[i];
+    }
+  }
+  return out;
+}
+
+BrirSet BrirSynthesizer::synthesize(const BrirGrid& grid) const {
+  const size_t na = grid.azimuths_deg.size(), nd = grid.distances_m.size();
+  std::vector<BinauralIr> irs(na * nd);
+  tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
+    irs[i] = synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
+  });
+  return BrirSet(config_.sample_rate, grid, std::move(irs));
+}
+
+}  // namespace sonomap::audio

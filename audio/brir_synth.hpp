@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Binaural room impulse responses of a shoebox room, synthesised from a measured HRIR set:
+// image sources (Allen & Berkley 1979) up to a given reflection order, each rendered with the
+// HRIR of its arrival direction in the head frame, delayed by r/c (fractional delay) and
+// scaled by the wall reflection product / r; after the mixing time an exponentially decaying,
+// interaurally decorrelated noise tail (per octave band) with the room's RT60.
+#pragma once
+
+#include "audio/brir_set.hpp"
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace sonomap::audio {
+
+// A rectangular room spanning [min_corner, max_corner] (metres, world axes, z up).
+struct ShoeboxRoom {
+  Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max_corner = Eigen::Vector3d(5.0, 4.0, 3.0);
+  Eigen::Vector3d size() const { return max_corner - min_corner; }
+  double volume() const;
+  double surface() const;
+};
+
+// Uniform wall absorption <-> RT60. Sabine: T = 0.161 V / (S a); Eyring: T = 0.161 V /
+// (-S ln(1 - a)). Eyring is the one used by the synthesiser (valid for absorptive rooms too).
+double sabine_rt60(const ShoeboxRoom& room, double absorption);
+double sabine_absorption(const ShoeboxRoom& room, double rt60);
+double eyring_rt60(const ShoeboxRoom& room, double absorption);
+double eyring_absorption(const ShoeboxRoom& room, double rt60);
+
+// Octave bands of the late tail (centre frequencies, Hz).
+const std::vector<double>& octave_band_centres();  // 125 .. 8000 Hz, 7 bands
+
+struct BrirSynthConfig {
+  ShoeboxRoom room;
+  // Head position; empty (NaN) means the room centre at 1.5 m above the floor (or mid-height
+  // in a room lower than 3 m).
+  Eigen::Vector3d listener = Eigen::Vector3d::Constant(NAN);
+  double listener_heading_deg = 0.0;  // direction the listener faces (0 = +x)
+  double rt60 = 0.5;                  // seconds; sets the wall absorption (Eyring)
+  std::vector<double> band_rt60;      // per octave band; empty: rt60 in every band
+  int max_order = 3;                  // image-source reflection order
+  double sample_rate = 48000.0;       // the HRIR set must already be at this rate
+  double length_s = 0.0;              // IR length; 0: the largest RT60 (60 dB of decay)
+  double speed_of_sound = 343.0;
+  double wall_margin = 0.5;  // a source beyond a wall pushes that wall to this far behind it
+  bool late_tail = true;
+  uint64_t seed = 1;  // tail noise (one stream per ear)
+};
+
+// Validates the config (room, listener inside, RT60 > 0, order >= 0, ...), throws
+// std::invalid_argument naming the offending value.
+void validate(const BrirSynthConfig& config);
+
+// The listener position the config resolves to.
+Eigen::Vector3d listener_position(const BrirSynthConfig& config);
+
+// Synthesises BRIR sets for one room: the late tail is made once and shared (a diffuse field
+// does not depend on the source position).
+class BrirSynthesizer {
+ public:
+  BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config);  // keeps its own copy
+
+  // The BRIR pair of a source at `azimuth_deg` (head frame, counter-clockwise from ahead) and
+  // horizontal `distance_m` from the head, at ear height.
+  BinauralIr synthesize(double azimuth_deg, double distance_m) const;
+  // The whole grid (parallel over grid points; the result does not depend on thread count).
+  BrirSet synthesize(const BrirGrid& grid) const;
+
+  size_t length() const { return length_; }
+  double absorption() const { return absorption_; }
+
+ private:
+  HrirSet hrirs_;
+  BrirSynthConfig config_;
+  Eigen::Vector3d listener_;
+  size_t length_ = 0;
+  double absorption_ = 0.0;
+  BinauralIr tail_;  // decaying noise from t = 0, faded in per source at its mixing time
+};
+
+}  // namespace sonomap::audio

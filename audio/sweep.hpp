@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The binaural sweep of the paper ("circular ranging"): the 2D circle is cut into 36 sectors
+// of 10 degrees; counter-clockwise from straight ahead each sector plays a 'tap' at its nearest
+// range and angle (through the BRIR of that azimuth and distance), or a 'woosh' when it is
+// not yet scanned. The "circular ranging of objects" mode plays each pseudo-object (circle split
+// at range jumps) once at its nearest point. Output: a stereo buffer and the event list.
+#pragma once
+
+#include "audio/brir_set.hpp"
+#include "audio/convolver.hpp"
+#include "audio/sounds.hpp"
+#include "core/raster.hpp"
+
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sonomap::audio {
+
+enum class SweepMode { Ranging, Objects };
+enum class SoundKind { Tap, Woosh };
+const char* to_string(SoundKind kind);
+const char* to_string(SweepMode mode);
+
+// Tap pitch from the BRIR distance: the paper shifts near taps down and far taps up.
+struct PitchMapping {
+  double near_below_m = 1.5;   // taps closer than this ...
+  double near_semitones = -4;  // ... are shifted by this
+  double far_above_m = 2.5;    // taps further than this ...
+  double far_semitones = 4;    // ... by this
+  bool inverted = false;       // parking-sensor convention: near higher, far lower
+  double semitones(double brir_distance_m) const;
+};
+
+// Which sounds play (both modes).
+struct SweepFilter {
+  double fov_centre_deg = 0.0;  // azimuth field of view: centre and full width
+  double fov_width_deg = 360.0;
+  double min_range_m = 0.0;  // distance window on the measured range
+  double max_range_m = std::numeric_limits<double>::infinity();
+  int max_taps = 0;  // ranging mode: only the N nearest taps (0: all)
+  bool in_view(double azimuth_deg) const;
+  bool in_window(double range_m) const;
+};
+
+struct SweepConfig {
+  SweepMode mode = SweepMode::Ranging;
+  double sample_rate = 48000.0;
+  int sectors = 36;
+  double period_s = 2.0;  // one full turn: sector s starts at s * period / sectors ...
+  std::vector<double> sector_onsets_s;  // ... unless given here (one per sector, increasing)
+  double environment_scale = 1.0;       // range x scale -> BRIR distance
+  double min_distance_m = 0.4;          // clamp of the scaled range (the BRIR grid's span)
+  double max_distance_m = 4.0;
+  double woosh_distance_m = 2.0;  // unknown sectors: woosh at the sector centre, this far
+  bool woosh_unknown = true;
+  PitchMapping pitch;
+  SweepFilter filter;
+  double object_jump_m_per_deg = 0.5;  // objects mode: split where the range jumps more
+  int max_objects = 5;                 // objects mode: the N nearest pseudo-objects
+  TapConfig tap;
+  WooshConfig woosh;
+  void validate() const;  // throws std::invalid_argument naming the field
+};
+
+struct SweepEvent {
+  double time_s = 0.0;  // onset in the output buffer
+  int sector = 0;
+  double azimuth_deg = 0.0;  // direction of the sound (bin centre, or sector centre for woosh)
+  double range_m = std::numeric_limits<double>::quiet_NaN();  // measured range; NaN: unknown
+  double brir_distance_m = 0.0;  // the grid distance used
+  double brir_azimuth_deg = 0.0;  // the grid azimuth used
+  double pitch_semitones = 0.0;
+  SoundKind sound = SoundKind::Tap;
+};
+
+struct SweepAudio {
+  double sample_rate = 0.0;
+  std::vector<float> left;
+  std::vector<float> right;
+  std::vector<SweepEvent> events;
+};
+
+// A pseudo-object: a run of known bins without a range jump, and its nearest point.
+struct PseudoObject {
+  int first_bin = 0;  // counter-clockwise from first_bin to last_bin (may wrap past 359)
+  int last_bin = 0;
+  int nearest_bin = 0;
+  double range_m = 0.0;
+  double azimuth_deg = 0.0;
+};
+
+// Throws std::invalid_argument unless every range is finite >= 0 or unknown (+inf).
+void validate_circle(const Circle& circle);
+// Splits the circle where neighbouring bins differ by more than jump_m_per_deg x bin width, or
+// where a bin is unknown. Sorted by first bin.
+std::vector<PseudoObject> split_objects(const Circle& circle, double jump_m_per_deg);
+
+// The sweep's schedule for a circle (pure: no audio). Events are in time order.
+std::vector<SweepEvent> schedule_sweep(const Circle& circle, const SweepConfig& config,
+                                       const BrirGrid& grid);
+
+class SweepRenderer {
+ public:
+  // The BRIR set must be at config.sample_rate (the harness resamples on load).
+  SweepRenderer(std::shared_ptr<const BrirSet> brirs, SweepConfig config = {});
+
+  const SweepConfig& config() const { return config_; }
+  const BrirSet& brirs() const { return convolver_.brirs(); }
+  std::vector<SweepEvent> schedule(const Circle& circle) const;
+  SweepAudio render(const Circle& circle);
+  SweepAudio render(std::vector<SweepEvent> events);
+  // The dry sound an event plays (tap pitch variants are made once, at construction).
+  const std::vector<float>& sound(SoundKind kind, double semitones) const;
+  void clear_cache() { convolver_.clear_cache(); }
+  size_t cached_spectra() const { return convolver_.cached_spectra(); }
+
+ private:
+  struct Variant {
+    std::vector<float> samples;
+    Spectrum spectrum;
+  };
+  const Variant& variant(SoundKind kind, double semitones) const;
+  size_t longest_sound() const;
+
+  SweepConfig config_;
+  std::map<double, Variant> taps_;  // by pitch shift, semitones
+  Variant woosh_;
+  BrirConvolver convolver_;
+  std::vector<AlignedSamples> scratch_;  // reused between renders
+};
+
+}  // namespace sonomap::audio
