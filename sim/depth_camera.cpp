@@ -3,6 +3,7 @@
 
 #include "sim/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sonomap::sim {
@@ -24,20 +25,21 @@ DepthImage DepthCamera::trace(const World& world, const Eigen::Isometry3d& world
   image.width = spec_.width;
   image.height = spec_.height;
   image.z.resize(hits.z.size());
-  image.cos_incidence.resize(hits.z.size());
+  image.incidence.resize(hits.z.size());
   const Eigen::Matrix3f world_R_camera = world_T_camera.linear().cast<float>();
   for (int v = 0; v < spec_.height; ++v)
     for (int u = 0; u < spec_.width; ++u) {
       const std::size_t p = static_cast<std::size_t>(v) * spec_.width + u;
       if (!std::isfinite(hits.z[p])) {
         image.z[p] = 0.0f;
-        image.cos_incidence[p] = 0.0f;
+        image.incidence[p] = 0.0f;
         continue;
       }
       image.z[p] = hits.z[p];
       const Eigen::Vector3f d = world_R_camera * Eigen::Vector3f(static_cast<float>((u - spec_.cx) / spec_.fx),
                                                                   static_cast<float>((v - spec_.cy) / spec_.fy), 1.0f);
-      image.cos_incidence[p] = std::abs(d.normalized().dot(hits.normal_world[p]));
+      const float cos_incidence = std::min(1.0f, std::abs(d.normalized().dot(hits.normal_world[p])));
+      image.incidence[p] = std::acos(cos_incidence);
     }
   return image;
 }
@@ -50,6 +52,7 @@ DepthImage DepthCamera::clip_to_range(DepthImage image) const {
 
 std::vector<Eigen::Vector3f> DepthCamera::back_project(const std::vector<float>& depth) const {
   std::vector<Eigen::Vector3f> points;
+  points.reserve(depth.size());
   for (int v = 0; v < spec_.height; ++v)
     for (int u = 0; u < spec_.width; ++u) {
       const float z = depth[static_cast<std::size_t>(v) * spec_.width + u];

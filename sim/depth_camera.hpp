@@ -16,7 +16,7 @@ struct DepthImage {
   int width = 0;
   int height = 0;
   std::vector<float> z;              // z-depth in metres; 0 = no return
-  std::vector<float> cos_incidence;  // |cos| of the angle between the ray and the surface normal
+  std::vector<float> incidence;  // angle between the ray and the surface normal, [0, pi/2] radians
 };
 
 class DepthCamera {
@@ -25,7 +25,7 @@ class DepthCamera {
   explicit DepthCamera(const CameraSpec& spec);
 
   // The exact z-depth of the first surface along each pixel's ray, before range limits
-  // (0 where nothing is hit), and the incidence cosine there.
+  // (0 where nothing is hit), and the incidence angle there.
   DepthImage trace(const World& world, const Eigen::Isometry3d& world_T_camera) const;
 
   // Pixels whose z-depth lies outside [min_range, max_range] become 0 ("no return").

@@ -14,9 +14,9 @@ namespace {
 // Keeps the grazing terms finite when a surface is seen exactly edge-on.
 constexpr double kMaxTheta = M_PI / 2 - 1e-3;
 
-double incidence_angle(float cos_incidence) {
-  return std::min(std::acos(std::clamp(static_cast<double>(cos_incidence), 0.0, 1.0)), kMaxTheta);
-}
+
+// Round half up; offsets are small, so the int conversion cannot overflow after the clamp.
+int nearest_int(double x) { return static_cast<int>(std::floor(std::clamp(x, -1e6, 1e6) + 0.5)); }
 
 RandomStream row_stream(const NoiseKey& key, StreamPurpose purpose, int row) {
   return RandomStream({key.seed, key.sensor, key.frame, static_cast<std::uint64_t>(purpose),
@@ -53,12 +53,12 @@ DepthImage jitter_lateral(const DepthImage& in, const NoiseKey& key) {
     RandomStream rng = row_stream(key, StreamPurpose::LateralJitter, v);
     for (int u = 0; u < in.width; ++u) {
       const std::size_t p = static_cast<std::size_t>(v) * in.width + u;
-      const double sigma = lateral_sigma_px(incidence_angle(in.cos_incidence[p]));
-      const int su = std::clamp(u + static_cast<int>(std::lround(rng.normal(sigma))), 0, in.width - 1);
-      const int sv = std::clamp(v + static_cast<int>(std::lround(rng.normal(sigma))), 0, in.height - 1);
+      const double sigma = lateral_sigma_px(in.incidence[p]);
+      const int su = std::clamp(u + nearest_int(rng.normal(sigma)), 0, in.width - 1);
+      const int sv = std::clamp(v + nearest_int(rng.normal(sigma)), 0, in.height - 1);
       const std::size_t source = static_cast<std::size_t>(sv) * in.width + su;
       out.z[p] = in.z[source];
-      out.cos_incidence[p] = in.cos_incidence[source];
+      out.incidence[p] = in.incidence[source];
     }
   });
   return out;
@@ -72,7 +72,7 @@ DepthImage add_axial_noise(const DepthImage& in, const NoiseKey& key) {
       const std::size_t p = static_cast<std::size_t>(v) * in.width + u;
       const double z = in.z[p];
       if (!(z > 0.0)) continue;
-      const double noisy = z + rng.normal(axial_sigma(z, incidence_angle(in.cos_incidence[p])));
+      const double noisy = z + rng.normal(axial_sigma(z, in.incidence[p]));
       out.z[p] = noisy > 0.0 ? static_cast<float>(noisy) : 0.0f;
     }
   });
@@ -92,9 +92,8 @@ DepthImage quantise_disparity(const DepthImage& in, double focal_px, double base
 
 DepthImage invalidate_grazing(const DepthImage& in, double max_angle) {
   DepthImage out = in;
-  const float min_cos = static_cast<float>(std::cos(max_angle));
   for (std::size_t p = 0; p < out.z.size(); ++p)
-    if (out.cos_incidence[p] < min_cos) out.z[p] = 0.0f;
+    if (out.incidence[p] > max_angle) out.z[p] = 0.0f;
   return out;
 }
 

@@ -171,6 +171,13 @@ RayHits World::cast(const PinholeRays& rays) const {
   const Eigen::Vector3f origin = rays.world_T_camera.translation().cast<float>();
   const int tiles_x = (rays.width + kTile - 1) / kTile;
   const int tiles_y = (rays.height + kTile - 1) / kTile;
+  // Optical-frame direction components per column and per row (padded to whole tiles).
+  std::vector<float> x_of_column(static_cast<std::size_t>(tiles_x) * kTile);
+  std::vector<float> y_of_row(static_cast<std::size_t>(tiles_y) * kTile);
+  for (std::size_t u = 0; u < x_of_column.size(); ++u)
+    x_of_column[u] = static_cast<float>((static_cast<double>(u) - rays.cx) / rays.fx);
+  for (std::size_t v = 0; v < y_of_row.size(); ++v)
+    y_of_row[v] = static_cast<float>((static_cast<double>(v) - rays.cy) / rays.fy);
 
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& range) {
     RTCIntersectContext context;
@@ -184,9 +191,7 @@ RayHits World::cast(const PinholeRays& rays) const {
           const int u = tx * kTile + i % kTile;
           const int v = ty * kTile + i / kTile;
           valid[i] = (u < rays.width && v < rays.height) ? -1 : 0;
-          const Eigen::Vector3f d_camera(static_cast<float>((u - rays.cx) / rays.fx),
-                                         static_cast<float>((v - rays.cy) / rays.fy), 1.0f);
-          const Eigen::Vector3f d = world_R_camera * d_camera;
+          const Eigen::Vector3f d = world_R_camera * Eigen::Vector3f(x_of_column[u], y_of_row[v], 1.0f);
           packet.ray.org_x[i] = origin.x();
           packet.ray.org_y[i] = origin.y();
           packet.ray.org_z[i] = origin.z();

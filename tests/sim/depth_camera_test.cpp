@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Exact (noise-free) depth against closed-form geometry.
 #include "scenes.hpp"
+#include "sim/depth_camera.hpp"
 #include "sim/simulation.hpp"
+#include "sim/world.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -82,6 +84,10 @@ TEST_CASE("points of a slanted wall lie on the wall in the world", "[sim][camera
   s.camera.cy = 60.0;
   Simulation centred(s);
   CHECK(depth_at(centred.render(0), 80, 60) == Approx(3.0).epsilon(1e-5));
+  // ... at an incidence of 30 degrees (the angle the wall was turned by).
+  World world(centred.scenario());
+  const DepthImage traced = DepthCamera(s.camera).trace(world, centred.true_camera_pose(0.0));
+  CHECK(traced.incidence[60 * 160 + 80] == Approx(M_PI / 6).margin(1e-5));
 }
 
 TEST_CASE("a sphere's silhouette radius in pixels matches the pinhole formula", "[sim][camera]") {

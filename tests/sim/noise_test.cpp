@@ -12,12 +12,12 @@ using namespace sonomap::sim;
 
 namespace {
 
-DepthImage flat(int w, int h, float z, float cos_incidence = 1.0f) {
+DepthImage flat(int w, int h, float z, float incidence = 0.0f) {
   DepthImage image;
   image.width = w;
   image.height = h;
   image.z.assign(static_cast<std::size_t>(w) * h, z);
-  image.cos_incidence.assign(image.z.size(), cos_incidence);
+  image.incidence.assign(image.z.size(), incidence);
   return image;
 }
 
@@ -49,7 +49,7 @@ TEST_CASE("axial noise std at range z matches Nguyen et al. 2012 within 5%", "[s
 TEST_CASE("axial noise grows at grazing incidence as Nguyen et al. 2012 say", "[sim][noise]") {
   const double z = 2.0, theta = 70.0 * M_PI / 180.0;
   const DepthImage out =
-      add_axial_noise(flat(200, 200, static_cast<float>(z), static_cast<float>(std::cos(theta))), NoiseKey{7, 0, 4});
+      add_axial_noise(flat(200, 200, static_cast<float>(z), static_cast<float>(theta)), NoiseKey{7, 0, 4});
   const double expected = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4) +
                           0.0001 / std::sqrt(z) * theta * theta / ((M_PI / 2 - theta) * (M_PI / 2 - theta));
   CHECK(std_dev(out.z, mean_of(out.z)) == Approx(expected).epsilon(0.05));
@@ -116,7 +116,7 @@ TEST_CASE("edge, grazing and dropout invalidation", "[sim][noise]") {
   CHECK(z(2, 5) == 0.0f);   // on the 3 m row
   CHECK(z(2, 2) == 1.0f);
 
-  const DepthImage slanted = flat(4, 1, 2.0f, static_cast<float>(std::cos(85.0 * M_PI / 180.0)));
+  const DepthImage slanted = flat(4, 1, 2.0f, static_cast<float>(85.0 * M_PI / 180.0));
   CHECK(invalidate_grazing(slanted, 80.0 * M_PI / 180.0).z[0] == 0.0f);
   CHECK(invalidate_grazing(slanted, 89.0 * M_PI / 180.0).z[0] == 2.0f);
 
