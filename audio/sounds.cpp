@@ -34,19 +34,22 @@ std::vector<float> make_tap(double fs, const TapConfig& c) {
   const double amplitudes[] = {1.0, 0.35, 0.12};
   const double decays[] = {1.0, 0.5, 0.3};
   const double attack = 0.001, fade = 0.005;
+  std::seed_seq seq{c.seed, uint64_t{0x7a9}};
+  std::mt19937_64 rng(seq);
   std::vector<float> s(n, 0.0f);
   for (size_t i = 0; i < n; ++i) {
     const double t = i / fs;
-    double v = 0.0;
+    double modes = 0.0;
     for (int m = 0; m < 3; ++m) {
       const double f = c.fundamental_hz * ratios[m];
       if (f >= 0.45 * fs) continue;
-      v += amplitudes[m] * std::exp(-t / (c.decay_s * decays[m])) * std::sin(2.0 * kPi * f * t);
+      modes += amplitudes[m] * std::exp(-t / (c.decay_s * decays[m])) * std::sin(2.0 * kPi * f * t);
     }
-    // Raised-cosine attack and a short fade so the sound starts and ends at zero.
+    if (t < attack) modes *= 0.5 - 0.5 * std::cos(kPi * t / attack);  // the bar swells in
+    const double noise = static_cast<double>(rng() >> 11) * 0x1.0p-53 * 2.0 - 1.0;
+    double v = modes + c.click_level * std::exp(-t / c.click_s) * noise;
     const double end = n / fs - t;
-    if (t < attack) v *= 0.5 - 0.5 * std::cos(kPi * t / attack);
-    if (end < fade) v *= 0.5 - 0.5 * std::cos(kPi * end / fade);
+    if (end < fade) v *= 0.5 - 0.5 * std::cos(kPi * end / fade);  // ends at zero
     s[i] = static_cast<float>(v);
   }
   normalise_peak(s, c.peak);

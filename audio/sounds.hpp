@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The two sounds of the sweep, synthesised deterministically (no downloaded samples):
-// a 'tap' (a struck wooden bar: a few inharmonic modes with a fast attack and exponential
-// decay) and a 'woosh' (noise through a resonance sweeping upwards, swelling and fading).
+// a 'tap' (a struck wooden bar: a broadband click of the strike, then a few inharmonic modes
+// decaying exponentially; the click carries the high-frequency cues that localise it) and a 'woosh' (noise through a resonance sweeping upwards, swelling and fading).
 #pragma once
 
 #include <cstdint>
@@ -13,7 +13,10 @@ struct TapConfig {
   double fundamental_hz = 660.0;  // the pitch that shifts with distance
   double duration_s = 0.1;
   double decay_s = 0.018;  // e-folding time of the fundamental; higher modes decay faster
-  double peak = 0.5;       // peak amplitude
+  double click_s = 0.0005;  // e-folding time of the strike's noise click
+  double click_level = 0.6;  // its amplitude relative to the fundamental mode
+  double peak = 0.5;         // peak amplitude
+  uint64_t seed = 5;         // the click's noise
 };
 
 struct WooshConfig {
