@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Mesh files (PLY, OBJ, STL; Open3D's readers) as sim::TriangleMesh.
+#pragma once
+
+#include "sim/scenario.hpp"
+
+#include <filesystem>
+
+namespace sonomap::harness {
+
+// Throws InputError naming the file when it is missing, unreadable, has no triangles, has a
+// non-finite vertex (naming its index) or a triangle index out of range.
+sim::TriangleMesh load_mesh(const std::filesystem::path& file);
+
+}  // namespace sonomap::harness
