@@ -16,6 +16,7 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 
 Rasteriser::Rasteriser(const RasterConfig& config) : config_(config) {
   config_.validate();
+  max_range2_ = config_.max_range * config_.max_range;
   circle_ = make_circle(config_);
   cylinder_ = make_cylinder(config_);
 }
@@ -39,8 +40,9 @@ void Rasteriser::add(const Eigen::Vector3f& point) {
 
   const double dx = static_cast<double>(point.x()) - origin_.position.x();
   const double dy = static_cast<double>(point.y()) - origin_.position.y();
-  const double range = std::hypot(dx, dy);
-  if (range > config_.max_range || range < kAxisRange) return;
+  const double range2 = dx * dx + dy * dy;
+  if (range2 > max_range2_ || range2 < kAxisRange * kAxisRange) return;
+  const double range = std::sqrt(range2);
 
   // Rotate the offset by -heading into the body frame (x ahead, y left).
   const double x = cos_heading_ * dx + sin_heading_ * dy;

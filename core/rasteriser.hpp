@@ -46,6 +46,7 @@ class Rasteriser {
   RasterOrigin origin_;
   double cos_heading_ = 1.0;
   double sin_heading_ = 0.0;
+  double max_range2_ = 0.0;
   Circle circle_;
   Cylinder cylinder_;
 };

@@ -63,7 +63,7 @@ Closest closest_on_edges(const Polygon& poly) {
     double t = length2 > 0.0 ? -(a.x * ex + a.y * ey) / length2 : 0.0;
     t = std::clamp(t, 0.0, 1.0);
     const Vertex p{a.x + t * ex, a.y + t * ey, a.z + t * (b.z - a.z)};
-    const double range = std::hypot(p.x, p.y);
+    const double range = std::sqrt(p.x * p.x + p.y * p.y);
     if (range < best.range) best = Closest{range, p};
   }
   return best;
@@ -111,9 +111,10 @@ BinSpan reachable_bins(const Polygon& poly, double distance_to_axis, int bins) {
   }
   if (hi - lo >= M_PI - 1e-9) return all;
   const double bin_width = 2.0 * M_PI / bins;
-  // One bin of margin on each side: rounding must never drop a bin (extra bins only cost time).
-  const int first = static_cast<int>(std::floor((a0 + lo) / bin_width)) - 1;
-  const int last = static_cast<int>(std::floor((a0 + hi) / bin_width)) + 1;
+  // A vertex on a bin edge lies in both closed wedges; the 1e-9 bin margin (far above atan2's
+  // rounding) makes sure both are visited.
+  const int first = static_cast<int>(std::floor((a0 + lo) / bin_width - 1e-9));
+  const int last = static_cast<int>(std::floor((a0 + hi) / bin_width + 1e-9));
   const int count = std::min(last - first + 1, bins);
   return BinSpan{((first % bins) + bins) % bins, count};
 }
@@ -135,13 +136,12 @@ class CellUpdater {
     return poly;
   }
 
-  // Lowers every cell of `cells` (one per bin) the slab-clipped polygon reaches.
-  void update(const Polygon& slab_polygon, RasterCell* cells) const {
+  // Lowers every cell of `cells` (one per bin) in `span` that the slab-clipped polygon reaches.
+  void update(const Polygon& slab_polygon, const BinSpan& span, RasterCell* cells) const {
     if (slab_polygon.n == 0) return;
     const Closest overall = closest_on_edges(slab_polygon);
     if (overall.range > config_.max_range) return;
     const int bins = config_.azimuth_bins;
-    const BinSpan span = reachable_bins(slab_polygon, overall.range, bins);
     for (int i = 0; i < span.count; ++i) {
       const int bin = (span.first + i) % bins;
       RasterCell& cell = cells[bin];
@@ -203,13 +203,20 @@ GroundTruthRasters ground_truth_rasters(const std::vector<GroundTruthTriangle>& 
     const double z_hi = std::max({tri[0].z(), tri[1].z(), tri[2].z()});
     if (z_hi < band_lo || z_lo > band_hi) continue;
     const Polygon poly = updater.local(tri);
+    const Polygon band = clip_to_slab(poly, band_lo, band_hi);
+    if (band.n == 0) continue;
+    // Every row polygon lies inside the band polygon: one range cull and one angular extent
+    // serve the circle and all rows.
+    const double band_range = closest_on_edges(band).range;
+    if (band_range > config.max_range) continue;
+    const BinSpan span = reachable_bins(band, band_range, config.azimuth_bins);
 
-    updater.update(clip_to_slab(poly, band_lo, band_hi), truth.circle.bins.data());
+    updater.update(band, span, truth.circle.bins.data());
     for (int row = 0; row < rows; ++row) {
       const double lo = origin.ground_z + config.row_bottom(row);
       const double hi = origin.ground_z + config.row_top(row);
       if (z_hi < lo || z_lo > hi) continue;
-      updater.update(clip_to_slab(poly, lo, hi), &truth.cylinder.at(row, 0));
+      updater.update(clip_to_slab(poly, lo, hi), span, &truth.cylinder.at(row, 0));
     }
   }
   return truth;
