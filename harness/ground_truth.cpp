@@ -69,6 +69,26 @@ Closest closest_on_edges(const Polygon& poly) {
   return best;
 }
 
+// A lower bound of the polygon's distance to the axis, exact up to rounding: 0 when the
+// polygon surrounds the axis (every edge turns the same way around it and the area is not
+// degenerate), else the closest edge. A sliver of area A around the axis that is taken as
+// degenerate has its edges within 2A / perimeter of the axis anyway.
+double distance_to_axis(const Polygon& poly) {
+  double twice_area = 0.0, extent2 = 0.0;
+  bool turns_left = true, turns_right = true;
+  for (int i = 0; i < poly.n; ++i) {
+    const Vertex& a = poly.v[static_cast<size_t>(i)];
+    const Vertex& b = poly.v[static_cast<size_t>((i + 1) % poly.n)];
+    const double cross = a.x * b.y - a.y * b.x;
+    twice_area += cross;
+    turns_left = turns_left && cross >= 0.0;
+    turns_right = turns_right && cross <= 0.0;
+    extent2 = std::max(extent2, a.x * a.x + a.y * a.y);
+  }
+  if ((turns_left || turns_right) && std::abs(twice_area) > 1e-12 * extent2) return 0.0;
+  return closest_on_edges(poly).range;
+}
+
 // Unit directions of the wedge edges: edge k at azimuth k * width degrees.
 std::vector<Eigen::Vector2d> wedge_edges(int bins) {
   std::vector<Eigen::Vector2d> edges(static_cast<size_t>(bins) + 1);
@@ -139,13 +159,13 @@ class CellUpdater {
   // Lowers every cell of `cells` (one per bin) in `span` that the slab-clipped polygon reaches.
   void update(const Polygon& slab_polygon, const BinSpan& span, RasterCell* cells) const {
     if (slab_polygon.n == 0) return;
-    const Closest overall = closest_on_edges(slab_polygon);
-    if (overall.range > config_.max_range) return;
+    const double lower_bound = distance_to_axis(slab_polygon);
+    if (lower_bound > config_.max_range) return;
     const int bins = config_.azimuth_bins;
     for (int i = 0; i < span.count; ++i) {
       const int bin = (span.first + i) % bins;
       RasterCell& cell = cells[bin];
-      if (overall.range >= cell.range) continue;  // cannot lower this cell
+      if (lower_bound >= cell.range) continue;  // cannot lower this cell
       const Closest c = closest_in_bin(slab_polygon, bin);
       if (c.range <= config_.max_range && c.range < cell.range) {
         cell.range = static_cast<float>(c.range);
@@ -207,7 +227,7 @@ GroundTruthRasters ground_truth_rasters(const std::vector<GroundTruthTriangle>& 
     if (band.n == 0) continue;
     // Every row polygon lies inside the band polygon: one range cull and one angular extent
     // serve the circle and all rows.
-    const double band_range = closest_on_edges(band).range;
+    const double band_range = distance_to_axis(band);
     if (band_range > config.max_range) continue;
     const BinSpan span = reachable_bins(band, band_range, config.azimuth_bins);
 

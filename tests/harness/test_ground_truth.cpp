@@ -260,6 +260,28 @@ TEST_CASE("Geometry outside the band or beyond the maximum range is unknown", "[
   CHECK_FALSE(raised.cylinder.at(0, 0).known());
 }
 
+TEST_CASE("A surface spanning over the sensor's axis reads 0 in every bin, however large",
+          "[ground_truth]") {
+  // One large triangle 1 m above the ground (within the band) with the sensor above it, and a
+  // wall 2 m ahead: the nearest surface point in every wedge is on the slab, right at the axis.
+  // (Its edges are at least 17 m away, beyond max_range: they must not cull it.)
+  Triangles scene{{Eigen::Vector3d(-30, -30, 1), Eigen::Vector3d(30, -30, 1), Eigen::Vector3d(0, 40, 1)}};
+  add_wall(scene, 2.0, -1.0, 2.0, 1.0, 0.0, 2.5);
+  RasterOrigin origin;
+  origin.position = Eigen::Vector3d(0.0, 0.0, 1.6);
+  const GroundTruthRasters truth = ground_truth_rasters(scene, origin, RasterConfig{});
+  for (int k = 0; k < 360; ++k) {
+    INFO("bin " << k);
+    REQUIRE(truth.circle.bins[static_cast<size_t>(k)].known());
+    CHECK(truth.circle.bins[static_cast<size_t>(k)].range == Approx(0.0).margin(1e-9));
+    CHECK(truth.circle.bins[static_cast<size_t>(k)].point.z() == Approx(1.0f));
+  }
+  // Row 9 is [1.0, 1.1] and holds the slab; row 10 sees only the wall.
+  CHECK(truth.cylinder.at(9, 0).range == Approx(0.0).margin(1e-9));
+  CHECK(truth.cylinder.at(10, 0).range == Approx(2.0).epsilon(1e-6));
+  CHECK_FALSE(truth.cylinder.at(10, 180).known());
+}
+
 TEST_CASE("Bad ground-truth input is rejected with a clear message", "[ground_truth]") {
   Triangles broken{{Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(NAN, 0, 1), Eigen::Vector3d(1, 1, 1)}};
   CHECK_THROWS_WITH(ground_truth_rasters(broken, RasterOrigin{}, RasterConfig{}),
