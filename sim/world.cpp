@@ -184,7 +184,7 @@ RayHits World::cast(const PinholeRays& rays) const {
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     RTCRayHit16 packet;
-    int valid[16];
+    alignas(64) int valid[16];  // rtcIntersect16 needs both pointers 64-byte aligned
     for (int ty = range.begin(); ty < range.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         for (int i = 0; i < 16; ++i) {
