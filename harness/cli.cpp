@@ -27,6 +27,7 @@ int run_cli(int argc, char** argv) {
   });
 
   // Commands: one line each (declared in cli.hpp).
+  add_bench_command(app, global);
   add_render_command(app, global);
 
   try {
