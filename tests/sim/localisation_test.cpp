@@ -64,3 +64,25 @@ TEST_CASE("negative localisation parameters are rejected", "[sim][localisation]"
   spec.yaw_drift = -0.1;
   CHECK_THROWS_WITH(LocalisationModel(spec, 1, 0, 0.1), Catch::Contains("yaw_drift"));
 }
+
+TEST_CASE("white pose noise has the configured sigma and no drift", "[sim][localisation]") {
+  LocalisationSpec spec;
+  spec.translation_noise = 0.02;
+  spec.yaw_noise = 0.01;
+  LocalisationModel model(spec, 5, 0, 1.0 / 30.0);
+  const int frames = 3000;
+  double sum_y = 0.0, sum_y2 = 0.0, sum_yaw2 = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const double t = f / 300.0;  // stays inside the walk
+    const Eigen::Isometry3d given = model.estimated_body_pose(walk(), f, t);
+    const double dy = given.translation().y();  // the walk is along x at y = 0
+    const double yaw = std::atan2(given.linear()(1, 0), given.linear()(0, 0));
+    sum_y += dy;
+    sum_y2 += dy * dy;
+    sum_yaw2 += yaw * yaw;
+  }
+  // 3000 samples: relative standard error of the std sqrt(1 / 6000) = 1.3%.
+  CHECK(std::sqrt(sum_y2 / frames) == Approx(0.02).epsilon(0.05));
+  CHECK(std::abs(sum_y / frames) < 4.0 * 0.02 / std::sqrt(frames));
+  CHECK(std::sqrt(sum_yaw2 / frames) == Approx(0.01).epsilon(0.05));
+}
