@@ -29,6 +29,8 @@ int run_cli(int argc, char** argv) {
   // Commands: one line each (declared in cli.hpp).
   add_bench_command(app, global);
   add_render_command(app, global);
+  add_brir_command(app, global);
+  add_sonify_command(app, global);
 
   try {
     app.parse(argc, argv);
