@@ -25,8 +25,6 @@ std::uint64_t mix_key(std::initializer_list<std::uint64_t> key) {
 
 RandomStream::RandomStream(std::initializer_list<std::uint64_t> key) : engine_(mix_key(key)) {}
 
-double RandomStream::uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
-
 double RandomStream::normal() {
   if (has_spare_) {
     has_spare_ = false;
