@@ -95,7 +95,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::PositiveNumber);
   command->add_option("--set", options->overrides,
                       "Override a scenario key, e.g. --set sensor.noise.model=none (repeatable)")
-      ->expected(1);
+      ->allow_extra_args(false);  // one key=value per --set, so a scenario after it stays positional
   command->callback([options, &global] { render(*options, global); });
 }
 

@@ -177,12 +177,12 @@ class MapReader {
   double non_negative(const std::string& name, double fallback) const {
     return checked(name, fallback, [](double v) { return v >= 0.0; }, "must be >= 0");
   }
-  int integer(const std::string& name, int fallback, int min_value) const {
+  int integer(const std::string& name, int fallback, int min_value, int max_value = INT_MAX) const {
     if (!has(name)) return fallback;
     const long long v = to_integer(ctx_, node_[name], sub(name));
-    if (v < min_value || v > INT_MAX)
+    if (v < min_value || v > max_value)
       ctx_.fail(node_[name], sub(name),
-                "must be between " + std::to_string(min_value) + " and " + std::to_string(INT_MAX));
+                "must be between " + std::to_string(min_value) + " and " + std::to_string(max_value));
     return static_cast<int>(v);
   }
   bool flag(const std::string& name, bool fallback) const {
@@ -434,8 +434,10 @@ std::vector<std::string> camera_keys_and(std::vector<std::string> more) {
 
 void read_camera(const MapReader& m, sim::CameraSpec& camera) {
   const Context& ctx = m.ctx();
-  camera.width = m.integer("width", camera.width, 1);
-  camera.height = m.integer("height", camera.height, 1);
+  // Larger than any depth camera; keeps a typo from asking for terabytes of image.
+  constexpr int kMaxPixels = 16384;
+  camera.width = m.integer("width", camera.width, 1, kMaxPixels);
+  camera.height = m.integer("height", camera.height, 1, kMaxPixels);
   if (m.has("intrinsics")) {
     const MapReader in(ctx, m.node()["intrinsics"], m.sub("intrinsics"), {"fx", "fy", "cx", "cy"});
     camera.fx = in.positive("fx", camera.fx);

@@ -71,7 +71,7 @@ TEST_CASE("render writes depth PNGs holding the wall distance and the true camer
   const fs::path out = dir.path() / "seq";
   const int frames = 4;
   REQUIRE(run_sonomap("-q render " + quoted(scene) + " --out " + quoted(out) + " --frames " +
-                          std::to_string(frames) + " --set sensor.noise.model=none",
+                          std::to_string(frames) + " --set sensor.noise.model=none --set seed=3",
                       dir.path() / "log.txt") == 0);
 
   const auto sequence = sonomap::harness::read_tum_sequence(out);

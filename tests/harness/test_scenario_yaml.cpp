@@ -221,6 +221,10 @@ TEST_CASE("bad input: each error names the file, the line and the key", "[scenar
     check_located(error_for(dir, with_line(4, "  intrinsics: {cx: -3}")), file, 4,
                   "sensor.intrinsics.cx");
   }
+  SECTION("an image size no camera has") {
+    check_located(error_for(dir, with_line(6, "  max_range: 5.0\n  width: 100000")), file, 7,
+                  "sensor.width");
+  }
   SECTION("max range not above min range") {
     check_located(error_for(dir, with_line(6, "  max_range: 0.3")), file, 6, "sensor.max_range");
   }
