@@ -74,7 +74,14 @@ void BrirConvolver::convolve(const Spectrum& sound, const Spectrum& brir, Aligne
   if (sound.size() != bins || brir.size() != bins || product.size() != bins ||
       scratch.size() != fft_.size())
     throw std::invalid_argument("BrirConvolver::convolve: buffer sizes do not match the plan");
-  for (size_t k = 0; k < bins; ++k) product[k] = sound[k] * brir[k];
+  // Written out: std::complex's operator* checks for NaN/inf (a libcall per bin, 5x slower).
+  const float* a = reinterpret_cast<const float*>(sound.data());
+  const float* b = reinterpret_cast<const float*>(brir.data());
+  float* p = reinterpret_cast<float*>(product.data());
+  for (size_t k = 0; k < 2 * bins; k += 2) {
+    p[k] = a[k] * b[k] - a[k + 1] * b[k + 1];
+    p[k + 1] = a[k] * b[k + 1] + a[k + 1] * b[k];
+  }
   fft_.inverse(product.data(), scratch.data());
 }
 
