@@ -2,6 +2,7 @@
 #include "harness/cli.hpp"
 
 #include "harness/errors.hpp"
+#include "harness/interrupt.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -27,21 +28,29 @@ int run_cli(int argc, char** argv) {
   });
 
   // Commands: one line each (declared in cli.hpp).
-  add_bench_command(app, global);
+  add_run_command(app, global);
+  add_compare_command(app, global);
+  add_report_command(app, global);
   add_render_command(app, global);
   add_brir_command(app, global);
   add_sonify_command(app, global);
+  add_bench_command(app, global);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
     return app.exit(e);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own status (e.g. some runs of a sweep failed)
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return kExitBadInput;
   } catch (const InputError& e) {
     std::fprintf(stderr, "sonomap: error: %s\n", e.what());
     return kExitBadInput;
+  } catch (const Interrupted&) {
+    std::fprintf(stderr, "sonomap: interrupted; partial output removed\n");
+    return kExitInterrupted;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sonomap: failure: %s\n", e.what());
     return kExitFailure;

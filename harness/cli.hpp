@@ -16,10 +16,13 @@ struct GlobalOptions {
 // Each command lives in its own source file and registers itself here.
 // The callback it sets runs after parsing; it throws InputError for bad input.
 // (one line per command: add yours here and in run_cli)
-void add_bench_command(CLI::App& app, const GlobalOptions& global);
+void add_run_command(CLI::App& app, const GlobalOptions& global);
+void add_compare_command(CLI::App& app, const GlobalOptions& global);
+void add_report_command(CLI::App& app, const GlobalOptions& global);
 void add_render_command(CLI::App& app, const GlobalOptions& global);
 void add_brir_command(CLI::App& app, const GlobalOptions& global);
 void add_sonify_command(CLI::App& app, const GlobalOptions& global);
+void add_bench_command(CLI::App& app, const GlobalOptions& global);
 
 // Parses argv and runs the chosen command. Returns the process exit status:
 // 0 success, 2 bad input (message names file, line and key), 1 other failure.

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/mapper_factory.hpp"
 
+#include "core/depth_only.hpp"
+#include "core/tsdf.hpp"
 #include "core/vdb_gpdf.hpp"
 #include "harness/errors.hpp"
 
@@ -98,15 +100,36 @@ std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& 
   return checked("vdb_gpdf", [&] { return std::make_unique<VdbGpdf>(c); });
 }
 
+std::unique_ptr<Mapper> make_tsdf(double voxel, const std::vector<Setting>& settings) {
+  TsdfConfig c;
+  if (voxel > 0) {
+    c.truncation *= voxel / c.voxel;  // keep the truncation at the same number of voxels
+    c.voxel = voxel;
+  }
+  FieldTable table{{"voxel", &c.voxel},           {"truncation", &c.truncation},
+                   {"carving", &c.space_carving}, {"weight_cap", &c.weight_cap},
+                   {"min_weight", &c.min_weight}, {"min_range", &c.min_range},
+                   {"max_range", &c.max_range}};
+  for (const Setting& s : settings) apply(table, "tsdf", s);
+  return checked("tsdf", [&] { return std::make_unique<Tsdf>(c); });
+}
+
+std::unique_ptr<Mapper> make_depth_only(const std::vector<Setting>& settings) {
+  for (const Setting& s : settings) apply({}, "depth_only", s);
+  return std::make_unique<DepthOnlyMapper>();
+}
+
 }  // namespace
 
-std::vector<std::string> mapper_names() { return {"vdb_gpdf"}; }
+std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "depth_only"}; }
 
 std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
                                     const std::vector<Setting>& settings) {
   if (voxel < 0 || !std::isfinite(voxel))
     throw InputError("--voxel must be a positive size in metres, got " + std::to_string(voxel));
   if (name == "vdb_gpdf") return make_vdb_gpdf(voxel, settings);
+  if (name == "tsdf") return make_tsdf(voxel, settings);
+  if (name == "depth_only") return make_depth_only(settings);
   std::string names;
   for (const auto& n : mapper_names()) names += (names.empty() ? "" : ", ") + n;
   throw InputError("--mapper " + name + ": unknown mapper (known: " + names + ")");

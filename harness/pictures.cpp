@@ -37,8 +37,7 @@ std::string quoted(const std::string& s) {
 
 }  // namespace
 
-// Writes the script beside the picture, draws it, and removes the script.
-static void draw(const fs::path& png, const std::string& script_text) {
+void draw_with_gnuplot(const fs::path& png, const std::string& script_text) {
   const fs::path script = fs::path(png).replace_extension(".gp");
   {
     std::ofstream out(script);
@@ -65,7 +64,7 @@ void plot_circle(const fs::path& png, const Circle& estimate, const Circle* trut
   const double ring = config.max_range * 1.08;
   std::ostringstream gp;
   gp.precision(6);
-  gp << "set terminal pngcairo size 900,900 enhanced font 'DejaVu Sans,11'\n"
+  gp << "set terminal pngcairo size 900,900 noenhanced font 'DejaVu Sans,11'\n"
      << "set output " << quoted(png.string()) << "\n"
      << "set title " << quoted(title) << "\n"
      << "set size ratio -1\nset grid\n"
@@ -78,10 +77,11 @@ void plot_circle(const fs::path& png, const Circle& estimate, const Circle* trut
   gp << "$ring << EOD\n";
   for (int k = 0; k < bins; ++k) {
     const RasterCell& c = estimate.bins[k];
+    if (!c.known()) continue;
     for (double a : {k * bin_deg, (k + 1) * bin_deg}) {
       double x, y;
       to_display(a, ring, x, y);
-      gp << x << ' ' << y << ' ' << (c.known() ? std::to_string(c.range) : "NaN") << '\n';
+      gp << x << ' ' << y << ' ' << c.range << '\n';
     }
     gp << "\n";
   }
@@ -125,7 +125,7 @@ void plot_circle(const fs::path& png, const Circle& estimate, const Circle* trut
      << "     $truth using 1:2 with lines lw 1.5 lc rgb 'black' title 'ground truth', \\\n"
      << "     $points using 1:2:3 with points pt 7 ps 0.7 lc palette title 'closest points'\n";
 
-  draw(png, gp.str());
+  draw_with_gnuplot(png, gp.str());
 }
 
 void plot_cylinder(const fs::path& png, const Cylinder& estimate, const RasterConfig& config,
@@ -134,7 +134,7 @@ void plot_cylinder(const fs::path& png, const Cylinder& estimate, const RasterCo
   const double bin_deg = 360.0 / bins;
   std::ostringstream gp;
   gp.precision(6);
-  gp << "set terminal pngcairo size 1200,420 enhanced font 'DejaVu Sans,11'\n"
+  gp << "set terminal pngcairo size 1200,420 noenhanced font 'DejaVu Sans,11'\n"
      << "set output " << quoted(png.string()) << "\n"
      << "set title " << quoted(title) << "\n"
      << "set xlabel 'azimuth (deg, + is left)'\nset ylabel 'height above ground (m)'\n"
@@ -155,7 +155,7 @@ void plot_cylinder(const fs::path& png, const Cylinder& estimate, const RasterCo
   gp << "EOD\n"
      << "plot $cells using 1:2:(" << bin_deg / 2 << "):(" << config.row_height / 2
      << "):3 with boxxyerror fs solid noborder lc palette notitle\n";
-  draw(png, gp.str());
+  draw_with_gnuplot(png, gp.str());
 }
 
 }  // namespace sonomap::harness

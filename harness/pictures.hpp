@@ -25,4 +25,7 @@ void plot_cylinder(const std::filesystem::path& png, const Cylinder& estimate,
 // Runs gnuplot on a script; throws std::runtime_error with gnuplot's message if it fails.
 void run_gnuplot(const std::filesystem::path& script);
 
+// Writes `script_text` beside `png` (as .gp), runs gnuplot on it and removes the script.
+void draw_with_gnuplot(const std::filesystem::path& png, const std::string& script_text);
+
 }  // namespace sonomap::harness

@@ -161,12 +161,23 @@ std::string pose_csv(const Eigen::Isometry3d& world_T_body) {
                      heading_of(world_T_body) * 180.0 / M_PI);
 }
 
+json tags_json(const std::vector<std::string>& tags) {
+  json out = json::object();
+  for (const std::string& t : tags) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0) throw InputError("--tag " + t + ": expected key=value");
+    out[t.substr(0, eq)] = t.substr(eq + 1);
+  }
+  return out;
+}
+
 }  // namespace
 
 RunOutcome run_scenario(const RunOptions& options) {
   if (options.frames < 0) throw InputError("--frames must be positive, got " + std::to_string(options.frames));
   if (options.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(options.every));
 
+  const json tags = tags_json(options.tags);
   RunSettings settings;
   std::vector<std::string> scenario_overrides;
   split_overrides(options.overrides, scenario_overrides, settings);
@@ -318,6 +329,7 @@ RunOutcome run_scenario(const RunOptions& options) {
                {"config", config},
                {"config_hash", config_hash(config)},
                {"evaluated_frames", circle_series.frames.size()},
+               {"tags", tags},
                {"metrics", {{"circle", circle_series.summary()},
                             {"cylinder", cylinder_series.summary()}}}};
 
@@ -390,6 +402,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Frames to draw (default: the last; -1: none)");
   cmd->add_option("--sweeps", options->sweep_frames,
                   "Frames to sonify as a WAV sweep (default: the last; -1: none)");
+  cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
   cmd->callback([options, &global] {
     options->quiet = global.quiet;

@@ -41,6 +41,8 @@ struct RunOptions {
   std::vector<int> sweep_frames;    // empty: the last evaluated frame; -1: none
   bool write_rasters = true;
   bool quiet = false;
+  // "key=value" labels recorded in summary.json (compare uses scenario=..., variant=...).
+  std::vector<std::string> tags;
 };
 
 struct RunOutcome {

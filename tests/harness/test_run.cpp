@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The whole chain: sensor -> mapper -> rasters -> ground truth -> metrics -> result directory.
+#include "cli_support.hpp"
+#include "test_scenario_files.hpp"
+
+#include "harness/run.hpp"
+
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using sonomap::test::ScratchDir;
+
+namespace {
+
+// The smoke scene at a quarter of the pixels: the same geometry, a quarter of the rays.
+std::vector<std::string> small_camera() {
+  return {"sensor.width=320", "sensor.height=240", "sensor.intrinsics.fx=262.5",
+          "sensor.intrinsics.fy=262.5", "sensor.intrinsics.cx=159.5", "sensor.intrinsics.cy=119.5"};
+}
+
+sonomap::harness::RunOptions smoke_options(const fs::path& out, const std::string& mapper, int frames) {
+  sonomap::harness::RunOptions o;
+  o.scenario = sonomap::test::shipped("scenes/smoke.yaml");
+  o.out = out;
+  o.mapper = mapper;
+  o.frames = frames;
+  o.overrides = small_camera();
+  o.picture_frames = {-1};
+  o.sweep_frames = {-1};
+  o.quiet = true;
+  return o;
+}
+
+std::vector<std::string> lines_of(const fs::path& file) {
+  std::istringstream in(sonomap::test::text_of(file));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+}  // namespace
+
+TEST_CASE("a run writes one row per evaluated frame and a full circle and cylinder for each",
+          "[run]") {
+  ScratchDir scratch("run-layout");
+  auto o = smoke_options(scratch.path() / "out", "depth_only", 12);
+  o.every = 5;  // frames 0, 5, 10 and the last (11)
+  sonomap::harness::run_scenario(o);
+  const fs::path dir = o.out;
+  CHECK(lines_of(dir / "frames.csv").size() == 1 + 4);
+  CHECK(lines_of(dir / "timings.csv").size() == 1 + 12);  // every frame is timed
+  CHECK(lines_of(dir / "circle.csv").size() == 1 + 4 * 360);
+  CHECK(lines_of(dir / "cylinder.csv").size() == 1 + 4 * 360 * 19);
+  std::ifstream in(dir / "summary.json");
+  const json summary = json::parse(in);
+  CHECK(summary["config"]["mapper"] == "depth_only");
+  CHECK(summary["evaluated_frames"] == 4);
+  CHECK(summary["ground_truth"] == true);
+  for (const auto& entry : fs::directory_iterator(scratch.path()))
+    CHECK(entry.path().filename() == "out");  // no partial directory left behind
+}
+
+TEST_CASE("the depth-only circle in the room covers about one camera view, well under 100%",
+          "[run]") {
+  // The Kinect's horizontal field of view is 2 atan(320 / 525) = 62.7 degrees: 17.4% of the
+  // circle, a little more where the floor-level obstacles are near. The paper: under 20%.
+  ScratchDir scratch("run-depth-only");
+  sonomap::harness::RunOptions o;
+  o.scenario = sonomap::test::shipped("scenes/room.yaml");
+  o.out = scratch.path() / "out";
+  o.mapper = "depth_only";
+  o.frames = 60;
+  o.every = 10;
+  o.overrides = small_camera();
+  o.picture_frames = {-1};
+  o.sweep_frames = {-1};
+  o.quiet = true;
+  const json summary = sonomap::harness::run_scenario(o).summary;
+  const double circle = summary["metrics"]["circle"]["mean"]["coverage"];
+  const double cylinder = summary["metrics"]["cylinder"]["mean"]["coverage"];
+  CHECK(circle > 0.08);
+  CHECK(circle < 0.20);
+  CHECK(cylinder < 0.20);
+}
+
+TEST_CASE("results are byte-identical across reruns and across 1 and 2 threads", "[run][determinism]") {
+  ScratchDir scratch("run-determinism");
+  std::vector<fs::path> dirs;
+  for (int threads : {1, 2, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    auto o = smoke_options(scratch.path() / ("out" + std::to_string(dirs.size())), "vdb_gpdf", 10);
+    o.every = 3;
+    sonomap::harness::run_scenario(o);
+    dirs.push_back(o.out);
+  }
+  for (const char* file : {"summary.json", "frames.csv", "circle.csv", "cylinder.csv"}) {
+    INFO(file);
+    const std::string first = sonomap::test::text_of(dirs[0] / file);
+    CHECK(!first.empty());
+    CHECK(sonomap::test::text_of(dirs[1] / file) == first);
+    CHECK(sonomap::test::text_of(dirs[2] / file) == first);
+  }
+}
+
+TEST_CASE("bad run options exit with status 2 and write nothing", "[run][cli]") {
+  ScratchDir scratch("run-bad");
+  const std::string scenario = sonomap::test::shipped("scenes/smoke.yaml").string();
+  const fs::path out = scratch.path() / "out";
+  SECTION("--frames 0") {
+    const auto r = sonomap::test::run_sonomap({"run", scenario, "--out", out.string(), "--frames", "0"});
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--frames") != std::string::npos);
+  }
+  SECTION("an output directory whose parent is a file") {
+    const fs::path file = scratch.write("a-file", "x");
+    const auto r = sonomap::test::run_sonomap({"run", scenario, "--out", (file / "out").string(), "--frames", "2"});
+    CHECK(r.status == 2);
+    CHECK(r.output.find("a-file") != std::string::npos);
+  }
+  SECTION("an obstacle band with min >= max") {
+    const auto r = sonomap::test::run_sonomap({"run", scenario, "--out", out.string(), "--frames", "2",
+                                               "--set", "raster.band_min=2", "--set", "raster.band_max=1"});
+    CHECK(r.status == 2);
+    CHECK(r.output.find("band") != std::string::npos);
+  }
+  SECTION("an unknown mapper setting") {
+    const auto r = sonomap::test::run_sonomap({"run", scenario, "--out", out.string(), "--frames", "2",
+                                               "--set", "mapper.voxle=0.1"});
+    CHECK(r.status == 2);
+    CHECK(r.output.find("voxle") != std::string::npos);
+  }
+  CHECK(sonomap::test::nothing_written(out));
+}
