@@ -11,6 +11,8 @@
 #include "harness/pictures.hpp"
 #include "harness/progress.hpp"
 #include "harness/scenario_yaml.hpp"
+#include "harness/sofa_io.hpp"
+#include "harness/sonify.hpp"
 #include "sim/simulation.hpp"
 #include "sim/world_geometry.hpp"
 
@@ -171,6 +173,57 @@ json tags_json(const std::vector<std::string>& tags) {
   return out;
 }
 
+// The sweep renderer, made at the first sweep: BRIRs from --brir, or synthesised for a shoebox
+// room that is the bounding box of the map around the listener (at least 2 x 2 x 2.4 m).
+class SweepMaker {
+ public:
+  SweepMaker(fs::path brir_dir, bool quiet) : brir_dir_(std::move(brir_dir)), quiet_(quiet) {}
+
+  void write(const Circle& circle, const std::vector<Eigen::Vector3f>& map_points,
+             const RasterOrigin& origin, const fs::path& wav, const fs::path& dir) {
+    if (!renderer_) {
+      SonifySetup setup;
+      std::shared_ptr<const audio::BrirSet> brirs;
+      if (!brir_dir_.empty()) {
+        setup.brir_dir = brir_dir_;
+        brirs = load_brirs(setup, quiet_);
+      } else {
+        Eigen::Vector3d lo = origin.position, hi = origin.position;
+        for (const auto& p : map_points) {
+          lo = lo.cwiseMin(p.cast<double>());
+          hi = hi.cwiseMax(p.cast<double>());
+        }
+        lo.z() = std::min(lo.z(), origin.ground_z);
+        const Eigen::Vector3d min_size(2.0, 2.0, 2.4), centre = 0.5 * (lo + hi);
+        lo = lo.cwiseMin(centre - 0.5 * min_size);
+        hi = hi.cwiseMax(centre + 0.5 * min_size);
+        // The listener must stand inside, off the walls.
+        lo = lo.cwiseMin(origin.position - Eigen::Vector3d::Constant(0.3));
+        hi = hi.cwiseMax(origin.position + Eigen::Vector3d::Constant(0.3));
+        audio::BrirSynthConfig room = room_from_box(lo, hi, origin.position, setup.room.rt60);
+        room.listener_heading_deg = origin.heading * 180.0 / M_PI;
+        room.max_order = setup.room.order;
+        brirs = std::make_shared<const audio::BrirSet>(
+            synthesize_brirs(room, setup.room.hrir_file, true));
+        const json room_json{{"min_corner", {lo.x(), lo.y(), lo.z()}},
+                             {"max_corner", {hi.x(), hi.y(), hi.z()}},
+                             {"listener", {origin.position.x(), origin.position.y(), origin.position.z()}},
+                             {"listener_heading_deg", room.listener_heading_deg},
+                             {"rt60", room.rt60}, {"max_order", room.max_order},
+                             {"hrir", setup.room.hrir_file.string()}};
+        std::ofstream(dir / "room.json") << room_json.dump(2) << '\n';
+      }
+      renderer_ = std::make_unique<audio::SweepRenderer>(brirs, setup.sweep);
+    }
+    write_sweep(renderer_->render(circle), wav);
+  }
+
+ private:
+  fs::path brir_dir_;
+  bool quiet_;
+  std::unique_ptr<audio::SweepRenderer> renderer_;
+};
+
 }  // namespace
 
 RunOutcome run_scenario(const RunOptions& options) {
@@ -226,6 +279,7 @@ RunOutcome run_scenario(const RunOptions& options) {
   MetricSeries circle_series, cylinder_series;
   std::vector<std::string> timing_columns;
   std::map<std::string, std::vector<double>> timing_samples;
+  SweepMaker sweeps(options.brir_dir, options.quiet);
   Progress progress("run " + scenario.name, frame_count, options.quiet);
 
   for (int i = 0; i < frame_count; ++i) {
@@ -292,6 +346,9 @@ RunOutcome run_scenario(const RunOptions& options) {
                       settings.raster,
                       fmt::format("{}: {} cylinder, frame {}", scenario.name, mapper->name(), i));
       }
+      if (chosen(options.sweep_frames, i, last_evaluated))
+        sweeps.write(rasteriser.circle(), surface, origin,
+                     dir / "sweeps" / fmt::format("frame_{:06d}.wav", i), dir / "sweeps");
     }
 
     if (timing_columns.empty()) {
@@ -402,6 +459,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Frames to draw (default: the last; -1: none)");
   cmd->add_option("--sweeps", options->sweep_frames,
                   "Frames to sonify as a WAV sweep (default: the last; -1: none)");
+  cmd->add_option("--brir", options->brir_dir,
+                  "BRIR directory for the sweeps (default: synthesise the room from the map)");
   cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
   cmd->callback([options, &global] {

@@ -10,7 +10,8 @@
 //   circle.csv     frame,bin,estimate,truth (unknown = empty field)
 //   cylinder.csv   frame,row,bin,estimate,truth
 //   pictures/      frame_NNNNNN_circle.png, frame_NNNNNN_cylinder.png
-//   sweeps/        frame_NNNNNN.wav, frame_NNNNNN.events.csv
+//   sweeps/        frame_NNNNNN.wav, frame_NNNNNN.events.csv (circular ranging of the map's
+//                  circle), room.json (the room the BRIRs were synthesised for)
 //   map.ply        the mapper's final surface mesh (mappers that have one)
 #pragma once
 
@@ -39,6 +40,10 @@ struct RunOptions {
   std::optional<std::uint64_t> seed;
   std::vector<int> picture_frames;  // empty: the last evaluated frame; -1: none
   std::vector<int> sweep_frames;    // empty: the last evaluated frame; -1: none
+  // BRIR directory (one SOFA per distance) for the sweeps; empty: synthesise a shoebox room
+  // from the map's bounding box around the listener at the first sweep (the paper's "room
+  // from the map").
+  std::filesystem::path brir_dir;
   bool write_rasters = true;
   bool quiet = false;
   // "key=value" labels recorded in summary.json (compare uses scenario=..., variant=...).
