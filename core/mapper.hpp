@@ -5,7 +5,10 @@
 #include "core/types.hpp"
 
 #include <Eigen/Core>
+#include <cmath>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sonomap {
@@ -38,6 +41,53 @@ class Mapper {
   virtual void query(const std::vector<Eigen::Vector3f>& points,
                      std::vector<DistanceQuery>& out) const = 0;
   virtual StageTimes last_stage_times() const { return {}; }
+  // The whole surface as a triangle mesh in the world (the harness writes it as PLY).
+  // Maps without a mesh leave both empty.
+  virtual void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
+                            std::vector<Eigen::Vector3i>& triangles) const {
+    vertices.clear();
+    triangles.clear();
+  }
+  // The configuration as (key, value) text, for summary.json.
+  virtual std::vector<std::pair<std::string, std::string>> config_entries() const { return {}; }
+  // Bytes held by the map (grids, caches); 0 if the map does not know.
+  virtual size_t memory_bytes() const { return 0; }
 };
+
+// Rejects a pose a mapper must not fuse: non-finite, or a rotation that is not orthonormal
+// with determinant +1 (tolerance 1e-3). Throws std::invalid_argument naming the frame.
+inline void check_pose(const Frame& frame) {
+  const Eigen::Matrix4d m = frame.world_T_camera.matrix();
+  if (!m.allFinite())
+    throw std::invalid_argument("frame " + std::to_string(frame.index) +
+                                ": world_T_camera has a NaN or infinite entry");
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  const double err = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (err > 1e-3 || r.determinant() < 0.0)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) +
+                                ": world_T_camera rotation is not orthonormal (|R^T R - I| = " +
+                                std::to_string(err) + ", det = " +
+                                std::to_string(r.determinant()) + ")");
+}
+
+// The frame's points whose distance from the camera lies in [min_range, max_range], in the
+// world. Non-finite points are skipped (documented behaviour, not an error) and counted.
+inline std::vector<Eigen::Vector3d> world_points(const Frame& frame, double min_range,
+                                                 double max_range, size_t* skipped = nullptr) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(frame.points_camera.size());
+  size_t bad = 0;
+  for (const auto& pc : frame.points_camera) {
+    if (!pc.allFinite()) {
+      ++bad;
+      continue;
+    }
+    const double r = pc.cast<double>().norm();
+    if (r < min_range || r > max_range) continue;
+    out.push_back(frame.world_T_camera * pc.cast<double>());
+  }
+  if (skipped) *skipped = bad;
+  return out;
+}
 
 }  // namespace sonomap

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// One small Gaussian process over surface points, the building block of VDB-GPDF (mapping.md):
+// a latent occupancy-like field f (targets all 1, zero mean, prior variance 1) turned into a
+// distance d. Used for the local GPs (one per local leaf) and the global GPs (one per global
+// leaf, trained on marching-cubes zero crossings).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Cholesky>
+#include <vector>
+
+namespace sonomap {
+
+enum class GpKernel {
+  RevertingSE,     // k = exp(-a r^2 / 2), a = lambda;    d = sqrt(2 |ln f| / a)   (default)
+  LogGpisMatern32  // k = (1 + a r) e^(-a r), a = sqrt(3 lambda);  d = |ln f| / a
+};
+
+struct GpParams {
+  GpKernel kernel = GpKernel::RevertingSE;
+  double lambda = 900.0;               // 1 / lengthscale^2 (l = 3.33 cm)
+  double noise = 0.01;                 // added to the diagonal of K
+  double variance_cap = 0.1;           // distance variance ceiling
+  double variance_on_surface = 0.001;  // where the propagated variance is undefined (d = 0)
+};
+
+struct GpPrediction {
+  bool valid = false;  // false only for non-finite input
+  double distance = 0.0;
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // unit, away from the surface (0 if flat)
+  double variance = 0.0;
+};
+
+class SurfaceGp {
+ public:
+  SurfaceGp() = default;
+  // Trains on the given points. Throws std::invalid_argument if points is empty or the
+  // parameters are out of range.
+  void train(std::vector<Eigen::Vector3f> points, const GpParams& params);
+  bool trained() const { return !points_.empty(); }
+  const std::vector<Eigen::Vector3f>& points() const { return points_; }
+
+  // Distance, gradient (grad d = -grad f / |grad f|) and, if asked, variance at x.
+  // f is evaluated relative to its largest kernel term, so far from the points the distance
+  // stays finite instead of underflowing to "f = 0".
+  GpPrediction predict(const Eigen::Vector3d& x, bool with_variance) const;
+
+ private:
+  GpParams params_;
+  double a_ = 0.0;  // kernel rate (see GpKernel)
+  std::vector<Eigen::Vector3f> points_;
+  Eigen::VectorXd alpha_;
+  Eigen::LLT<Eigen::MatrixXd> llt_;
+};
+
+void validate(const GpParams& params);
+
+}  // namespace sonomap

@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "core/marching_cubes.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace sonomap {
+namespace {
+
+// Cube corners (unit offsets) and edges as (lower corner offset, axis).
+constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                               {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+constexpr int kEdgeCorners[12][2] = {{0, 1}, {1, 2}, {3, 2}, {0, 3}, {4, 5}, {5, 6},
+                                     {7, 6}, {4, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+constexpr int kEdgeAxis[12] = {0, 1, 0, 1, 0, 1, 0, 1, 2, 2, 2, 2};
+constexpr int kFaces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                              {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+
+int edge_between(int a, int b) {
+  for (int e = 0; e < 12; ++e)
+    if ((kEdgeCorners[e][0] == a && kEdgeCorners[e][1] == b) ||
+        (kEdgeCorners[e][0] == b && kEdgeCorners[e][1] == a))
+      return e;
+  return -1;
+}
+
+using TriangleList = std::vector<std::array<int, 3>>;  // edge indices
+
+// Our own triangle table, derived instead of typed in: on each face the zero crossing is a set
+// of segments, one per run of inside corners (so on an ambiguous face the inside corners are
+// kept apart; the rule depends on the face alone, so neighbouring cubes agree and the surface
+// is closed). The segments chain into loops (every cut edge lies on two faces); each loop is
+// oriented so its normal points to the outside corners and fanned into triangles.
+TriangleList triangles_for(int config) {
+  auto inside = [config](int corner) { return (config >> corner) & 1; };
+  std::array<std::vector<int>, 12> links;
+  for (const auto& face : kFaces) {
+    for (int i = 0; i < 4; ++i) {
+      const int prev = face[(i + 3) % 4];
+      if (!inside(face[i]) || inside(prev)) continue;  // not the start of an inside run
+      int last = i;
+      while (inside(face[(last + 1) % 4])) last = (last + 1) % 4;
+      const int enter = edge_between(prev, face[i]);
+      const int leave = edge_between(face[last], face[(last + 1) % 4]);
+      links[enter].push_back(leave);
+      links[leave].push_back(enter);
+    }
+  }
+  auto midpoint = [](int e) -> Eigen::Vector3d {
+    const int* a = kCorner[kEdgeCorners[e][0]];
+    const int* b = kCorner[kEdgeCorners[e][1]];
+    return Eigen::Vector3d(a[0] + b[0], a[1] + b[1], a[2] + b[2]) * 0.5;
+  };
+  TriangleList out;
+  std::array<bool, 12> used{};
+  for (int start = 0; start < 12; ++start) {
+    if (links[start].empty() || used[start]) continue;
+    std::vector<int> loop{start};
+    used[start] = true;
+    int prev = -1, cur = start;
+    for (;;) {
+      const int next = links[cur][0] != prev ? links[cur][0] : links[cur][1];
+      if (next == start || loop.size() == 12) break;
+      loop.push_back(next);
+      used[next] = true;
+      prev = cur;
+      cur = next;
+    }
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero(), outward = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < loop.size(); ++i) {
+      normal += midpoint(loop[i]).cross(midpoint(loop[(i + 1) % loop.size()]));
+      const int a = kEdgeCorners[loop[i]][0], b = kEdgeCorners[loop[i]][1];
+      const Eigen::Vector3d ab(kCorner[b][0] - kCorner[a][0], kCorner[b][1] - kCorner[a][1],
+                               kCorner[b][2] - kCorner[a][2]);
+      outward += inside(a) ? ab : Eigen::Vector3d(-ab);
+    }
+    if (normal.dot(outward) < 0.0) std::reverse(loop.begin(), loop.end());
+    for (size_t i = 1; i + 1 < loop.size(); ++i) out.push_back({loop[0], loop[i], loop[i + 1]});
+  }
+  return out;
+}
+
+const std::array<TriangleList, 256>& triangle_table() {
+  static const std::array<TriangleList, 256> table = [] {
+    std::array<TriangleList, 256> t;
+    for (int c = 0; c < 256; ++c) t[c] = triangles_for(c);
+    return t;
+  }();
+  return table;
+}
+
+constexpr int kSpan = kLeafDim + 1;  // a leaf's cubes read one voxel beyond it
+inline int local_index(int x, int y, int z) { return (x * kSpan + y) * kSpan + z; }
+
+}  // namespace
+
+void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, double voxel_size,
+                float min_weight, SurfaceMesh& out) {
+  const auto& table = triangle_table();
+  std::array<float, kSpan * kSpan * kSpan> dist, weight;
+  DistanceWeightGrid::ConstAccessor acc = grid.getConstAccessor();
+  bool any_inside = false, any_outside = false;
+  for (int x = 0; x < kSpan; ++x)
+    for (int y = 0; y < kSpan; ++y)
+      for (int z = 0; z < kSpan; ++z) {
+        const auto v = acc.getValue(origin.offsetBy(x, y, z));
+        const int i = local_index(x, y, z);
+        dist[i] = v[0];
+        weight[i] = v[1];
+        if (v[1] >= min_weight) (v[0] >= 0.0f ? any_inside : any_outside) = true;
+      }
+  if (!any_inside || !any_outside) return;
+
+  std::array<int, kSpan * kSpan * kSpan * 3> vertex_of_edge;
+  vertex_of_edge.fill(-1);
+  auto vertex = [&](int x, int y, int z, int axis) {
+    int& id = vertex_of_edge[local_index(x, y, z) * 3 + axis];
+    if (id >= 0) return id;
+    const int step[3] = {axis == 0, axis == 1, axis == 2};
+    const float da = dist[local_index(x, y, z)];
+    const float db = dist[local_index(x + step[0], y + step[1], z + step[2])];
+    const double t = static_cast<double>(da) / (static_cast<double>(da) - db);
+    const Eigen::Vector3d p(origin.x() + x + 0.5 + t * step[0], origin.y() + y + 0.5 + t * step[1],
+                            origin.z() + z + 0.5 + t * step[2]);
+    id = static_cast<int>(out.vertices.size());
+    out.vertices.push_back((p * voxel_size).cast<float>());
+    return id;
+  };
+  for (int x = 0; x < kLeafDim; ++x)
+    for (int y = 0; y < kLeafDim; ++y)
+      for (int z = 0; z < kLeafDim; ++z) {
+        int config = 0;
+        bool valid = true;
+        for (int c = 0; c < 8 && valid; ++c) {
+          const int i = local_index(x + kCorner[c][0], y + kCorner[c][1], z + kCorner[c][2]);
+          valid = weight[i] >= min_weight;
+          if (dist[i] >= 0.0f) config |= 1 << c;
+        }
+        if (!valid || config == 0 || config == 255) continue;
+        for (const auto& tri : table[config]) {
+          Eigen::Vector3i ids;
+          for (int k = 0; k < 3; ++k) {
+            const int e = tri[k];
+            const int* o = kCorner[kEdgeCorners[e][0]];
+            ids[k] = vertex(x + o[0], y + o[1], z + o[2], kEdgeAxis[e]);
+          }
+          out.triangles.push_back(ids);
+        }
+      }
+}
+
+SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float min_weight) {
+  SurfaceMesh mesh;
+  for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+    march_leaf(grid, leaf->origin(), voxel_size, min_weight, mesh);
+  return mesh;
+}
+
+void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out) {
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const int n = std::max(1, static_cast<int>(std::ceil(longest / spacing)));
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n - i; ++j)
+        out.push_back(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n));
+  }
+}
+
+std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched) {
+  std::vector<openvdb::Coord> out;
+  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf) {
+    const openvdb::Coord origin = leaf->origin();
+    out.push_back(origin);
+    unsigned subsets = 0;  // bit s set: the lower neighbour along axis subset s is affected
+    for (auto v = leaf->cbeginValueOn(); v; ++v) {
+      const openvdb::Coord local = v.getCoord() - origin;
+      const unsigned m = (local.x() == 0) | (local.y() == 0) << 1 | (local.z() == 0) << 2;
+      for (unsigned s = 1; s < 8; ++s)
+        if ((s & m) == s) subsets |= 1u << s;
+    }
+    for (unsigned s = 1; s < 8; ++s)
+      if (subsets & (1u << s))
+        out.push_back(origin.offsetBy((s & 1) ? -kLeafDim : 0, (s & 2) ? -kLeafDim : 0,
+                                      (s & 4) ? -kLeafDim : 0));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples) {
+  if (samples.empty()) {
+    leaves_.erase(leaf_origin);
+    return;
+  }
+  if (min_z_ > max_z_) {
+    min_z_ = max_z_ = leaf_origin.z();
+  } else {
+    min_z_ = std::min(min_z_, leaf_origin.z());
+    max_z_ = std::max(max_z_, leaf_origin.z());
+  }
+  leaves_[leaf_origin] = std::move(samples);
+}
+
+void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
+                           std::vector<Eigen::Vector3f>& out) const {
+  if (leaves_.empty() || !(radius >= 0.0)) return;
+  const int x0 = static_cast<int>(std::floor((center.x() - radius) / leaf_size_)) * kLeafDim;
+  const int x1 = static_cast<int>(std::floor((center.x() + radius) / leaf_size_)) * kLeafDim;
+  const int y0 = static_cast<int>(std::floor((center.y() - radius) / leaf_size_)) * kLeafDim;
+  const int y1 = static_cast<int>(std::floor((center.y() + radius) / leaf_size_)) * kLeafDim;
+  const double r2 = radius * radius;
+  for (int x = x0; x <= x1; x += kLeafDim)
+    for (int y = y0; y <= y1; y += kLeafDim)
+      for (int z = min_z_; z <= max_z_; z += kLeafDim) {
+        const auto it = leaves_.find(openvdb::Coord(x, y, z));
+        if (it == leaves_.end()) continue;
+        for (const auto& p : it->second) {
+          const double dx = p.x() - center.x(), dy = p.y() - center.y();
+          if (dx * dx + dy * dy <= r2) out.push_back(p);
+        }
+      }
+}
+
+size_t SurfaceCache::sample_count() const {
+  size_t n = 0;
+  for (const auto& kv : leaves_) n += kv.second.size();
+  return n;
+}
+
+}  // namespace sonomap

@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Marching cubes over a sparse (distance, weight) grid, per 8^3 leaf, and a per-leaf cache of
+// dense surface samples for rasters.
+//
+// Grid convention (shared by VDB-GPDF and the TSDF peer): index-space voxel ijk holds the value
+// at the world point (ijk + 0.5) * voxel_size (floor binning). Value x = signed distance,
+// negative in free space and positive behind surfaces; value y = fusion weight, 0 = never
+// observed. A cube (8 neighbouring voxel centres) is valid when all corner weights reach the
+// minimum weight; the surface is its zero crossing.
+#pragma once
+
+#include <Eigen/Core>
+#include <openvdb/openvdb.h>
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace sonomap {
+
+using DistanceWeightGrid = openvdb::Grid<openvdb::Vec2STree>;
+
+struct SurfaceMesh {
+  std::vector<Eigen::Vector3f> vertices;   // world coordinates
+  std::vector<Eigen::Vector3i> triangles;  // counter-clockwise seen from free space
+  void clear() {
+    vertices.clear();
+    triangles.clear();
+  }
+};
+
+// Hash for leaf / voxel coordinates.
+struct CoordHash {
+  size_t operator()(const openvdb::Coord& c) const {
+    const uint64_t h = static_cast<uint64_t>(static_cast<uint32_t>(c.x())) * 73856093u ^
+                       static_cast<uint64_t>(static_cast<uint32_t>(c.y())) * 19349663u ^
+                       static_cast<uint64_t>(static_cast<uint32_t>(c.z())) * 83492791u;
+    return static_cast<size_t>(h);
+  }
+};
+
+constexpr int kLeafDim = DistanceWeightGrid::TreeType::LeafNodeType::DIM;  // 8
+
+// The leaf origin (index space) of the leaf holding voxel ijk.
+inline openvdb::Coord leaf_origin_of(const openvdb::Coord& ijk) {
+  return ijk & ~(kLeafDim - 1);
+}
+
+// Index-space voxel holding world point p (floor binning).
+inline openvdb::Coord voxel_of(const Eigen::Vector3d& p, double voxel_size) {
+  return openvdb::Coord(static_cast<int>(std::floor(p.x() / voxel_size)),
+                        static_cast<int>(std::floor(p.y() / voxel_size)),
+                        static_cast<int>(std::floor(p.z() / voxel_size)));
+}
+
+// Appends the triangles of the cubes whose lowest corner lies in the leaf at leaf_origin.
+// Vertices shared by cubes of this leaf are not duplicated.
+void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& leaf_origin,
+                double voxel_size, float min_weight, SurfaceMesh& out);
+
+// The whole surface: every leaf of the grid, in the grid's (deterministic) leaf order.
+SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float min_weight);
+
+// Points on the triangles themselves, so that neighbouring samples are at most `spacing`
+// apart along every edge: each triangle is subdivided into n^2 sub-triangles with
+// n = ceil(longest edge / spacing) and all their corners are emitted.
+void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out);
+
+// Leaves that must be re-marched after the voxels in `touched` changed: each touched leaf and,
+// for voxels on a leaf's lower faces, the lower neighbours whose cubes reach into it.
+// Returned sorted (deterministic).
+std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched);
+
+// Dense surface samples per leaf of a grid, refreshed leaf by leaf, queried by a horizontal
+// disc so the cost follows the queried area, not the whole map.
+class SurfaceCache {
+ public:
+  explicit SurfaceCache(double leaf_size = 0.4) : leaf_size_(leaf_size) {}
+  // Replaces (or, if samples is empty, drops) the samples of one leaf.
+  void set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples);
+  // Appends all samples within horizontal distance `radius` of center.
+  void collect(const Eigen::Vector3d& center, double radius,
+               std::vector<Eigen::Vector3f>& out) const;
+  size_t leaf_count() const { return leaves_.size(); }
+  size_t sample_count() const;
+  void clear() { leaves_.clear(); }
+
+ private:
+  double leaf_size_;  // world size of one leaf (8 voxels)
+  std::unordered_map<openvdb::Coord, std::vector<Eigen::Vector3f>, CoordHash> leaves_;
+  int min_z_ = 0, max_z_ = -1;  // range of leaf origins' z (index space) seen so far
+};
+
+}  // namespace sonomap

@@ -1,0 +1,471 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "core/vdb_gpdf.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+
+namespace sonomap {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr float kUnobservedDistance = -100.0f;
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("VdbGpdfConfig: " + what);
+}
+
+template <typename F>
+void parallel_for_each_index(size_t n, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) f(i);
+  });
+}
+
+Eigen::Vector3d voxel_centre(const openvdb::Coord& ijk, double voxel) {
+  return Eigen::Vector3d(ijk.x() + 0.5, ijk.y() + 0.5, ijk.z() + 0.5) * voxel;
+}
+
+Eigen::Vector3d leaf_centre(const openvdb::Coord& origin, double voxel) {
+  return (Eigen::Vector3d(origin.x(), origin.y(), origin.z()) + Eigen::Vector3d::Constant(kLeafDim * 0.5)) *
+         voxel;
+}
+
+// One query point's contribution: the voxel it falls in, its signed distance and weight.
+struct QueryUpdate {
+  openvdb::Coord voxel;
+  float distance;
+  float weight;
+};
+
+// The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
+// one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
+// of its 26 neighbours; else the nearest of all (rare: points far from every surface).
+struct LocalGps {
+  double voxel = 0.02;
+  std::vector<openvdb::Coord> origins;
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<SurfaceGp> gps;
+  std::unordered_map<openvdb::Coord, int, CoordHash> index;
+
+  int nearest(const Eigen::Vector3d& q) const {
+    const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
+    if (auto it = index.find(home); it != index.end()) return it->second;
+    int best = -1;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    auto consider = [&](int i) {
+      const double d2 = (centres[i] - q).squaredNorm();
+      if (d2 < best_d2 || (d2 == best_d2 && i < best)) {
+        best_d2 = d2;
+        best = i;
+      }
+    };
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = index.find(home.offsetBy(dx * kLeafDim, dy * kLeafDim, dz * kLeafDim));
+          if (it != index.end()) consider(it->second);
+        }
+    if (best >= 0) return best;
+    for (int i = 0; i < static_cast<int>(centres.size()); ++i) consider(i);
+    return best;
+  }
+};
+
+}  // namespace
+
+// A global leaf's GP over its zero crossings, trained at the first query that needs it.
+struct VdbGpdf::GlobalLeaf {
+  Eigen::Vector3d centre;
+  std::vector<Eigen::Vector3f> crossings;
+  mutable std::once_flag trained;
+  mutable SurfaceGp gp;
+};
+
+void VdbGpdfConfig::validate() const {
+  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  require(positive(local_voxel), "local_voxel must be > 0, got " + std::to_string(local_voxel));
+  require(positive(global_voxel), "global_voxel must be > 0, got " + std::to_string(global_voxel));
+  require(voxel_downsample >= 1, "voxel_downsample must be >= 1");
+  require(positive(lambda), "lambda must be > 0, got " + std::to_string(lambda));
+  require(positive(map_noise), "map_noise must be > 0, got " + std::to_string(map_noise));
+  require(positive(global_map_noise), "global_map_noise must be > 0");
+  require(positive(query_step), "query_step must be > 0");
+  require(trunc_behind >= 0 && trunc_front >= 0, "trunc_behind/trunc_front must be >= 0");
+  require(positive(carving_step), "carving_step must be > 0");
+  require(positive(variance_cap) && positive(variance_on_surface), "variances must be > 0");
+  require(weight_cap >= 0.0, "weight_cap must be >= 0 (0 = no cap)");
+  require(g_gpdf_min_touched >= 1, "g_gpdf_min_touched must be >= 1");
+  require(positive(smooth_min), "smooth_min must be > 0");
+  require(global_neighbours >= 1, "global_neighbours must be >= 1");
+  require(positive(query_radius), "query_radius must be > 0");
+  require(positive(gradient_scale), "gradient_scale must be > 0");
+  require(recon_min_weight >= 0.0 && std::isfinite(recon_min_weight),
+          "recon_min_weight must be >= 0");
+  require(min_range >= 0.0 && positive(max_range) && min_range < max_range,
+          "need 0 <= min_range < max_range");
+}
+
+GpParams VdbGpdfConfig::gp_params() const {
+  GpParams p;
+  p.kernel = kernel;
+  p.lambda = lambda;
+  p.noise = map_noise;
+  p.variance_cap = variance_cap;
+  p.variance_on_surface = variance_on_surface;
+  return p;
+}
+
+GpParams VdbGpdfConfig::global_gp_params() const {
+  GpParams p = gp_params();
+  p.noise = global_map_noise;
+  return p;
+}
+
+double carving_frame_bound(double weight_cap, double d_old, double carve) {
+  if (!(weight_cap > 0.0) || !std::isfinite(weight_cap))
+    return std::numeric_limits<double>::infinity();
+  const double r = weight_cap / (weight_cap + 1.0);
+  // d_old r^k - carve (1 - r^k) < 0  <=>  r^k < carve / (d_old + carve)
+  return std::floor(std::log(carve / (d_old + carve)) / std::log(r)) + 1.0;
+}
+
+VdbGpdf::VdbGpdf(VdbGpdfConfig config)
+    : config_(config), cache_(kLeafDim * config.global_voxel) {
+  config_.validate();
+  openvdb::initialize();
+  grid_ = DistanceWeightGrid::create(openvdb::Vec2s(kUnobservedDistance, 0.0f));
+}
+
+VdbGpdf::~VdbGpdf() = default;
+
+void VdbGpdf::integrate(const Frame& frame) {
+  check_pose(frame);
+  times_.stages.clear();
+  const auto t_start = Clock::now();
+  const std::vector<Eigen::Vector3d> points =
+      world_points(frame, config_.min_range, config_.max_range);
+  const Eigen::Vector3d origin = frame.world_T_camera.translation();
+  const GpParams gp_params = config_.gp_params();
+
+  // 1. Local grid and one GP per leaf (trained in parallel; each writes only its own slot).
+  auto t0 = Clock::now();
+  openvdb::MaskGrid local(false);
+  {
+    auto acc = local.getAccessor();
+    for (const auto& p : points) acc.setValueOn(voxel_of(p, config_.local_voxel));
+  }
+  LocalGps locals;
+  locals.voxel = config_.local_voxel;
+  std::vector<std::vector<Eigen::Vector3f>> training;
+  for (auto leaf = local.tree().cbeginLeaf(); leaf; ++leaf) {
+    std::vector<Eigen::Vector3f> pts;
+    int i = 0;
+    for (auto v = leaf->cbeginValueOn(); v; ++v, ++i)
+      if (i % config_.voxel_downsample == 0)
+        pts.push_back(voxel_centre(v.getCoord(), config_.local_voxel).cast<float>());
+    locals.index.emplace(leaf->origin(), static_cast<int>(locals.origins.size()));
+    locals.origins.push_back(leaf->origin());
+    locals.centres.push_back(leaf_centre(leaf->origin(), config_.local_voxel));
+    training.push_back(std::move(pts));
+  }
+  times_.stages.emplace_back("voxelise", ms_since(t0));
+  t0 = Clock::now();
+  locals.gps.resize(training.size());
+  parallel_for_each_index(training.size(),
+                          [&](size_t i) { locals.gps[i].train(training[i], gp_params); });
+  times_.stages.emplace_back("local_gps", ms_since(t0));
+
+  // 2-3. Query points and their signed distances (negative in free space, positive behind),
+  // from the nearest local GP. A query point's value is moved to the centre of the voxel it
+  // falls in by first order (value + signed gradient . (centre - q)): the marching cubes read
+  // values at voxel centres, and binning the raw values would shift the surface by up to half
+  // a voxel (measured: 0.8 voxel worst case on a sphere).
+  t0 = Clock::now();
+  std::vector<std::vector<QueryUpdate>> updates(training.size());
+  parallel_for_each_index(training.size(), [&](size_t leaf) {
+    auto observed = grid_->getConstAccessor();
+    auto& out = updates[leaf];
+    const double vg = config_.global_voxel;
+    // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
+    auto fuse = [&](const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
+                    double variance) {
+      const openvdb::Coord v = voxel_of(q, vg);
+      const double at_centre = value + toward_inside.dot(voxel_centre(v, vg) - q);
+      const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
+      out.push_back({v, static_cast<float>(at_centre), weight});
+    };
+    // sign: +1 behind the surface, -1 in front of it.
+    auto fuse_query = [&](const Eigen::Vector3d& q, double sign) {
+      const int gp = locals.nearest(q);
+      if (gp < 0) return;
+      // Each local GP knows only its own patch, so its distance is an upper bound: take the
+      // smaller of the nearest leaf's and the source point's own leaf's (the leaf nearest by
+      // centre can hold a patch far from q's foot point; measured on a sphere: front/carve
+      // value RMSE 2.0 -> 1.1 cm).
+      GpPrediction pred = locals.gps[gp].predict(q, config_.inverse_variance_fusion);
+      if (gp != static_cast<int>(leaf)) {
+        const GpPrediction own = locals.gps[leaf].predict(q, config_.inverse_variance_fusion);
+        if (own.valid && (!pred.valid || own.distance < pred.distance)) pred = own;
+      }
+      if (!pred.valid) return;  // f <= 0: no distance, skipped
+      fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance);
+    };
+    for (const auto& pf : training[leaf]) {
+      const Eigen::Vector3d p = pf.cast<double>();
+      Eigen::Vector3d u = origin - p;
+      const double range = u.norm();
+      if (!(range > 0.0)) continue;
+      u /= range;  // toward the sensor: the direction the query points are placed along
+      // The surface normal (toward free space) from the local GP one step in front of p;
+      // where that has no gradient, the ray direction.
+      Eigen::Vector3d normal = u;
+      {
+        const Eigen::Vector3d q = p + config_.query_step * u;
+        const int gp = locals.nearest(q);
+        const GpPrediction pred = gp >= 0 ? locals.gps[gp].predict(q, false) : GpPrediction{};
+        if (pred.valid && pred.gradient.allFinite() && pred.gradient.dot(u) > 0.1)
+          normal = pred.gradient;
+      }
+      {
+        const int gp = locals.nearest(p);
+        const GpPrediction pred = locals.gps[gp].predict(p, config_.inverse_variance_fusion);
+        const double d = pred.valid ? pred.distance : 0.0;
+        fuse(p, -d, -normal, pred.valid ? pred.variance : config_.variance_on_surface);
+      }
+      // Along the normal, not the ray: behind points along a grazing ray leave thin objects.
+      for (int j = 1; j <= config_.trunc_behind; ++j)
+        fuse_query(p - j * config_.query_step * normal, 1.0);
+      for (int j = 1; j <= config_.trunc_front; ++j)
+        fuse_query(p + j * config_.query_step * normal, -1.0);
+      if (!config_.free_space_carving) continue;
+      const int steps = static_cast<int>(std::floor(range / config_.carving_step));
+      for (int i = 1; i < steps; ++i) {
+        const Eigen::Vector3d q = p + i * config_.carving_step * u;
+        if (observed.getValue(voxel_of(q, vg))[1] > 0.0f) fuse_query(q, -1.0);
+      }
+    }
+  });
+  times_.stages.emplace_back("query_points", ms_since(t0));
+
+  // 4. Fusion: sum the frame's updates per voxel (in a fixed order), then blend each touched
+  // voxel once. Without a cap this equals one running-average update per query point.
+  t0 = Clock::now();
+  DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
+  {
+    auto acc = frame_sums.getAccessor();
+    for (const auto& leaf_updates : updates)
+      for (const auto& u : leaf_updates) {
+        const openvdb::Vec2s v = acc.getValue(u.voxel);
+        acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
+      }
+  }
+  {
+    auto acc = grid_->getAccessor();
+    const bool capped = config_.weight_cap > 0.0;
+    for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
+      for (auto v = leaf->cbeginValueOn(); v; ++v) {
+        const openvdb::Vec2s sum = *v;
+        const openvdb::Vec2s old = acc.getValue(v.getCoord());
+        const float w_old = old[1];
+        const float w_new = w_old + sum[1];
+        const float d_new = (old[0] * w_old + sum[0]) / w_new;
+        acc.setValue(v.getCoord(),
+                     openvdb::Vec2s(d_new, capped ? std::min<float>(w_new, config_.weight_cap)
+                                                  : w_new));
+      }
+  }
+  times_.stages.emplace_back("fusion", ms_since(t0));
+
+  // 5. G-GPDF and surface samples for the touched leaves.
+  t0 = Clock::now();
+  update_global_field(frame_sums);
+  times_.stages.emplace_back("g_gpdf", ms_since(t0));
+  times_.stages.emplace_back("total", ms_since(t_start));
+}
+
+void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
+  openvdb::MaskGrid touched(false);
+  touched.topologyUnion(frame_sums);
+  std::unordered_map<openvdb::Coord, int, CoordHash> touched_count;
+  for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
+    touched_count[leaf->origin()] = static_cast<int>(leaf->onVoxelCount());
+  const std::vector<openvdb::Coord> dirty = dirty_leaves(touched);
+
+  const double voxel = config_.global_voxel;
+  const float min_weight = static_cast<float>(config_.recon_min_weight);
+  std::vector<SurfaceMesh> meshes(dirty.size());
+  std::vector<std::vector<Eigen::Vector3f>> samples(dirty.size());
+  parallel_for_each_index(dirty.size(), [&](size_t i) {
+    march_leaf(*grid_, dirty[i], voxel, min_weight, meshes[i]);
+    sample_surface(meshes[i], 0.5 * voxel, samples[i]);
+  });
+  for (size_t i = 0; i < dirty.size(); ++i) {
+    cache_.set(dirty[i], std::move(samples[i]));
+    const auto count = touched_count.find(dirty[i]);
+    if (count == touched_count.end() || count->second < config_.g_gpdf_min_touched) continue;
+    if (meshes[i].vertices.empty()) {
+      global_.erase(dirty[i]);
+      continue;
+    }
+    auto leaf = std::make_unique<GlobalLeaf>();
+    leaf->centre = leaf_centre(dirty[i], voxel);
+    leaf->crossings = std::move(meshes[i].vertices);
+    global_[dirty[i]] = std::move(leaf);
+  }
+}
+
+void VdbGpdf::surface_points(const Eigen::Vector3d& center, double radius,
+                             std::vector<Eigen::Vector3f>& out) const {
+  cache_.collect(center, radius, out);
+}
+
+DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
+  DistanceQuery out;
+  if (!xf.allFinite() || global_.empty()) return out;
+  const Eigen::Vector3d x = xf.cast<double>();
+  const double voxel = config_.global_voxel;
+  const double leaf_size = kLeafDim * voxel;
+  const size_t k = static_cast<size_t>(config_.global_neighbours);
+  using Candidate = std::pair<double, const GlobalLeaf*>;  // squared centre distance
+  std::vector<Candidate> found;
+  auto by_distance = [](const Candidate& a, const Candidate& b) {
+    if (a.first != b.first) return a.first < b.first;
+    return std::tie(a.second->centre.x(), a.second->centre.y(), a.second->centre.z()) <
+           std::tie(b.second->centre.x(), b.second->centre.y(), b.second->centre.z());
+  };
+  // Leaves outside the 5x5x5 block around x's leaf have centres at least 2.5 leaves away, so
+  // the block is exact whenever its k-th nearest centre is nearer than that.
+  const openvdb::Coord home = leaf_origin_of(voxel_of(x, voxel));
+  for (int dx = -2; dx <= 2; ++dx)
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dz = -2; dz <= 2; ++dz) {
+        auto it = global_.find(home.offsetBy(dx * kLeafDim, dy * kLeafDim, dz * kLeafDim));
+        if (it != global_.end())
+          found.emplace_back((it->second->centre - x).squaredNorm(), it->second.get());
+      }
+  std::sort(found.begin(), found.end(), by_distance);
+  const double exact_within = 2.5 * leaf_size;
+  if (found.size() < k || found[k - 1].first > exact_within * exact_within) {
+    found.clear();
+    for (const auto& kv : global_)
+      found.emplace_back((kv.second->centre - x).squaredNorm(), kv.second.get());
+    std::sort(found.begin(), found.end(), by_distance);
+  }
+  if (found.size() > k) found.resize(k);
+  const double reach = config_.query_radius + 0.5 * std::sqrt(3.0) * leaf_size;
+  double d_min = std::numeric_limits<double>::infinity();
+  std::vector<GpPrediction> preds;
+  std::vector<const GlobalLeaf*> used;
+  for (const auto& [d2, leaf] : found) {
+    if (d2 > reach * reach) continue;
+    std::call_once(leaf->trained, [&] { leaf->gp.train(leaf->crossings, config_.global_gp_params()); });
+    GpPrediction p = leaf->gp.predict(x, true);
+    if (!p.valid) continue;
+    d_min = std::min(d_min, p.distance);
+    preds.push_back(p);
+    used.push_back(leaf);
+  }
+  if (preds.empty() || d_min > config_.query_radius) return out;
+  // Smooth minimum d = sum d_i e^(-s d_i) / sum e^(-s d_i), shifted by d_min for range.
+  double wsum = 0.0, dsum = 0.0, vsum = 0.0;
+  for (const auto& p : preds) {
+    const double w = std::exp(-config_.smooth_min * (p.distance - d_min));
+    wsum += w;
+    dsum += w * p.distance;
+    vsum += w * p.variance;
+  }
+  out.observed = true;
+  out.distance = static_cast<float>(dsum / wsum);
+  out.variance = static_cast<float>(vsum / wsum);
+  out.gradient = soft_nearest_direction(x, used).cast<float>();
+  return out;
+}
+
+Eigen::Vector3d VdbGpdf::soft_nearest_direction(const Eigen::Vector3d& x,
+                                                const std::vector<const GlobalLeaf*>& leaves) const {
+  // Gradient of -l^2 ln sum_i exp(-|x - c_i|^2 / 2 l^2) over the crossings c_i of all the
+  // leaves together: x minus the kernel-weighted mean crossing. Unlike the mean of the
+  // per-leaf GP gradients it sees no leaf borders and no alternating GP weights (measured at
+  // 0.2 m from a sphere of 0.3 m: worst angle 12.7 -> 8.5 degrees).
+  const double a = config_.lambda / (config_.gradient_scale * config_.gradient_scale);
+  double r2_min = std::numeric_limits<double>::infinity();
+  for (const GlobalLeaf* leaf : leaves)
+    for (const auto& c : leaf->crossings) r2_min = std::min(r2_min, (x - c.cast<double>()).squaredNorm());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  double wsum = 0.0;
+  for (const GlobalLeaf* leaf : leaves)
+    for (const auto& c : leaf->crossings) {
+      const double w = std::exp(-0.5 * a * ((x - c.cast<double>()).squaredNorm() - r2_min));
+      wsum += w;
+      mean += w * c.cast<double>();
+    }
+  const Eigen::Vector3d g = x - mean / wsum;
+  const double n = g.norm();
+  return n > 0.0 && std::isfinite(n) ? Eigen::Vector3d(g / n) : Eigen::Vector3d::Zero();
+}
+
+void VdbGpdf::query(const std::vector<Eigen::Vector3f>& points,
+                    std::vector<DistanceQuery>& out) const {
+  out.assign(points.size(), DistanceQuery{});
+  parallel_for_each_index(points.size(), [&](size_t i) { out[i] = query_point(points[i]); });
+}
+
+void VdbGpdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
+                           std::vector<Eigen::Vector3i>& triangles) const {
+  SurfaceMesh mesh =
+      march_grid(*grid_, config_.global_voxel, static_cast<float>(config_.recon_min_weight));
+  vertices = std::move(mesh.vertices);
+  triangles = std::move(mesh.triangles);
+}
+
+std::vector<std::pair<std::string, std::string>> VdbGpdf::config_entries() const {
+  const auto& c = config_;
+  auto num = [](double v) { return std::to_string(v); };
+  return {{"mapper", name()},
+          {"local_voxel", num(c.local_voxel)},
+          {"voxel_downsample", std::to_string(c.voxel_downsample)},
+          {"global_voxel", num(c.global_voxel)},
+          {"kernel", c.kernel == GpKernel::RevertingSE ? "reverting_se" : "log_gpis_matern32"},
+          {"lambda", num(c.lambda)},
+          {"map_noise", num(c.map_noise)},
+          {"query_step", num(c.query_step)},
+          {"trunc_behind", std::to_string(c.trunc_behind)},
+          {"trunc_front", std::to_string(c.trunc_front)},
+          {"free_space_carving", c.free_space_carving ? "true" : "false"},
+          {"carving_step", num(c.carving_step)},
+          {"variance_cap", num(c.variance_cap)},
+          {"inverse_variance_fusion", c.inverse_variance_fusion ? "true" : "false"},
+          {"weight_cap", num(c.weight_cap)},
+          {"g_gpdf_min_touched", std::to_string(c.g_gpdf_min_touched)},
+          {"smooth_min", num(c.smooth_min)},
+          {"global_neighbours", std::to_string(c.global_neighbours)},
+          {"query_radius", num(c.query_radius)},
+          {"gradient_scale", num(c.gradient_scale)},
+          {"recon_min_weight", num(c.recon_min_weight)},
+          {"min_range", num(c.min_range)},
+          {"max_range", num(c.max_range)}};
+}
+
+size_t VdbGpdf::memory_bytes() const {
+  size_t bytes = static_cast<size_t>(grid_->memUsage());
+  bytes += cache_.sample_count() * sizeof(Eigen::Vector3f);
+  for (const auto& kv : global_) {
+    const size_t n = kv.second->crossings.size();
+    bytes += sizeof(GlobalLeaf) + n * sizeof(Eigen::Vector3f);
+    if (kv.second->gp.trained()) bytes += n * n * sizeof(double) + n * (sizeof(double) + 12);
+  }
+  return bytes;
+}
+
+}  // namespace sonomap

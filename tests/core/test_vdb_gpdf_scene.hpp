@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Test scenes for the mapping tests with an independent, closed-form ray caster (ray-box and
+// ray-sphere intersections) and exact distances, so ground truth never comes from the mapper.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace sonomap::test {
+
+struct Box {
+  Eigen::Vector3d lo, hi;
+};
+struct Sphere {
+  Eigen::Vector3d centre;
+  double radius;
+};
+
+struct Scene {
+  std::vector<Box> boxes;
+  std::vector<Sphere> spheres;
+
+  // Nearest hit t > 0 of o + t d (d unit), or +inf.
+  double cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& b : boxes) {  // slabs
+      double t0 = -std::numeric_limits<double>::infinity(), t1 = -t0;
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(d[a]) < 1e-12) {
+          if (o[a] < b.lo[a] || o[a] > b.hi[a]) t0 = t1 + 1;  // parallel and outside
+          continue;
+        }
+        double ta = (b.lo[a] - o[a]) / d[a], tb = (b.hi[a] - o[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+      }
+      if (t0 <= t1 && t0 > 1e-9) best = std::min(best, t0);
+    }
+    for (const auto& s : spheres) {
+      const Eigen::Vector3d oc = o - s.centre;
+      const double b = oc.dot(d), c = oc.squaredNorm() - s.radius * s.radius;
+      const double disc = b * b - c;
+      if (disc < 0) continue;
+      const double t = -b - std::sqrt(disc);
+      if (t > 1e-9) best = std::min(best, t);
+    }
+    return best;
+  }
+
+  // Exact unsigned distance to the nearest surface.
+  double distance(const Eigen::Vector3d& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& b : boxes) {
+      const Eigen::Vector3d out = (b.lo - p).cwiseMax(p - b.hi).cwiseMax(0.0);
+      double d = out.norm();
+      if (d == 0.0) d = std::min((p - b.lo).minCoeff(), (b.hi - p).minCoeff());  // inside
+      best = std::min(best, d);
+    }
+    for (const auto& s : spheres) best = std::min(best, std::abs((p - s.centre).norm() - s.radius));
+    return best;
+  }
+};
+
+// Camera at eye looking at target, world z up; optical frame x right, y down, z forward.
+inline Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear().col(0) = x;
+  t.linear().col(1) = y;
+  t.linear().col(2) = z;
+  t.translation() = eye;
+  return t;
+}
+
+// A noise-free pinhole depth frame (coarse by default to keep tests fast).
+inline Frame render(const Scene& scene, const Eigen::Isometry3d& world_T_camera, int index = 0,
+                    int width = 160, int height = 120, double max_range = 5.0) {
+  Frame f;
+  f.index = index;
+  f.width = width;
+  f.height = height;
+  f.depth.assign(static_cast<size_t>(width) * height, 0.0f);
+  f.world_T_camera = f.world_T_camera_true = world_T_camera;
+  f.world_T_body = f.world_T_body_true = world_T_camera;
+  const double fx = 0.82 * width, fy = fx, cx = (width - 1) / 2.0, cy = (height - 1) / 2.0;
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      const Eigen::Vector3d ray_cam((u - cx) / fx, (v - cy) / fy, 1.0);
+      const Eigen::Vector3d dir_cam = ray_cam.normalized();
+      const double t = scene.cast(world_T_camera.translation(), world_T_camera.linear() * dir_cam);
+      if (!(t <= max_range)) continue;
+      const Eigen::Vector3d pc = t * dir_cam;
+      f.depth[static_cast<size_t>(v) * width + u] = static_cast<float>(pc.z());
+      f.points_camera.push_back(pc.cast<float>());
+    }
+  return f;
+}
+
+// Poses on a circle of `radius` around `target`, `height` above it, all looking at it.
+inline std::vector<Eigen::Isometry3d> orbit(const Eigen::Vector3d& target, double radius,
+                                            double height, int count) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < count; ++i) {
+    const double a = 2.0 * M_PI * i / count;
+    poses.push_back(look_at(target + Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), height),
+                            target));
+  }
+  return poses;
+}
+
+}  // namespace sonomap::test
