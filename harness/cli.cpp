@@ -15,6 +15,7 @@ std::string code_version() { return std::string(SONOMAP_VERSION) + " (" SONOMAP_
 int run_cli(int argc, char** argv) {
   CLI::App app{"sonomap: depth sensing -> online map -> 360-degree rasters -> binaural sound"};
   app.require_subcommand(1);
+  app.fallthrough();  // --quiet and --threads work after the command name too
   app.set_version_flag("--version", code_version());
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress bar and no summary screen");

@@ -71,4 +71,19 @@ sim::TriangleMesh load_mesh(const fs::path& file) {
   return mesh;
 }
 
+void save_mesh_ply(const fs::path& file, const std::vector<Eigen::Vector3f>& vertices,
+                   const std::vector<Eigen::Vector3i>& triangles) {
+  open3d::geometry::TriangleMesh mesh;
+  mesh.vertices_.reserve(vertices.size());
+  for (const auto& v : vertices) mesh.vertices_.push_back(v.cast<double>());
+  mesh.triangles_ = triangles;
+  open3d::utility::VerbosityContextManager silence(open3d::utility::VerbosityLevel::Error);
+  silence.Enter();
+  const bool ok = open3d::io::WriteTriangleMesh(file.string(), mesh, /*write_ascii=*/false,
+                                                /*compressed=*/false, /*write_vertex_normals=*/false,
+                                                /*write_vertex_colors=*/false);
+  silence.Exit();
+  if (!ok) throw std::runtime_error("cannot write the mesh " + file.string());
+}
+
 }  // namespace sonomap::harness

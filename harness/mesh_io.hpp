@@ -12,4 +12,8 @@ namespace sonomap::harness {
 // non-finite vertex (naming its index) or a triangle index out of range.
 sim::TriangleMesh load_mesh(const std::filesystem::path& file);
 
+// Writes a mesh as binary PLY with Open3D (the map's surface). Throws std::runtime_error.
+void save_mesh_ply(const std::filesystem::path& file, const std::vector<Eigen::Vector3f>& vertices,
+                   const std::vector<Eigen::Vector3i>& triangles);
+
 }  // namespace sonomap::harness

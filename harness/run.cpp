@@ -6,6 +6,7 @@
 #include "harness/ground_truth.hpp"
 #include "harness/interrupt.hpp"
 #include "harness/mapper_factory.hpp"
+#include "harness/mesh_io.hpp"
 #include "harness/metrics.hpp"
 #include "harness/output.hpp"
 #include "harness/pictures.hpp"
@@ -401,6 +402,12 @@ RunOutcome run_scenario(const RunOptions& options) {
       f->close();
       if (f->fail()) throw std::runtime_error("writing the result files in " + dir.string() + " failed");
     }
+  {
+    std::vector<Eigen::Vector3f> vertices;
+    std::vector<Eigen::Vector3i> triangles;
+    mapper->surface_mesh(vertices, triangles);
+    if (!triangles.empty()) save_mesh_ply(dir / "map.ply", vertices, triangles);
+  }
   {
     std::ofstream out(dir / "summary.json");
     out << summary.dump(2) << '\n';
