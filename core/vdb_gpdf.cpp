@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "core/vdb_gpdf.hpp"
 
+#include <openvdb/math/DDA.h>
+#include <openvdb/math/Ray.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -249,11 +251,21 @@ void VdbGpdf::integrate(const Frame& frame) {
       for (int j = 1; j <= config_.trunc_front; ++j)
         fuse_query(p + j * config_.query_step * normal, -1.0);
       if (!config_.free_space_carving) continue;
-      const int steps = static_cast<int>(std::floor(range / config_.carving_step));
-      for (int i = 1; i < steps; ++i) {
-        const Eigen::Vector3d q = p + i * config_.carving_step * u;
+      // One carving point per global voxel the ray crosses (DDA, mid-segment), from one
+      // carving step in front of p to the sensor: fixed steps along fixed rays (a static
+      // camera) can skip a voxel forever, and then a moved object is never carved there.
+      using Ray = openvdb::math::Ray<double>;
+      const double start = config_.carving_step;
+      if (range <= start) continue;
+      const Eigen::Vector3d s0 = (p + start * u) / vg;
+      const Ray ray(openvdb::Vec3d(s0.x(), s0.y(), s0.z()), openvdb::Vec3d(u.x(), u.y(), u.z()),
+                    0.0, (range - start) / vg);
+      openvdb::math::DDA<Ray, 0> dda(ray);
+      do {
+        const double mid = 0.5 * (dda.time() + std::min(dda.next(), ray.t1()));
+        const Eigen::Vector3d q = p + (start + mid * vg) * u;
         if (observed.getValue(voxel_of(q, vg))[1] > 0.0f) fuse_query(q, -1.0);
-      }
+      } while (dda.step());
     }
   });
   times_.stages.emplace_back("query_points", ms_since(t0));
