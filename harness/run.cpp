@@ -14,6 +14,7 @@
 #include "harness/scenario_yaml.hpp"
 #include "harness/sofa_io.hpp"
 #include "harness/sonify.hpp"
+#include "harness/tum_io.hpp"
 #include "sim/simulation.hpp"
 #include "sim/world_geometry.hpp"
 
@@ -174,6 +175,65 @@ json tags_json(const std::vector<std::string>& tags) {
   return out;
 }
 
+// Where frames come from: the simulator (with ground truth) or a recorded TUM RGB-D sequence.
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual std::string name() const = 0;
+  virtual int frame_count() const = 0;
+  virtual Frame frame(int i) = 0;
+  virtual double ground_z() const = 0;
+  virtual std::uint64_t seed() const = 0;
+  // World triangles at time t, or nullopt when there is no ground truth (recorded data).
+  virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
+};
+
+class SimulatedSource final : public FrameSource {
+ public:
+  SimulatedSource(sim::Scenario scenario, const fs::path& file) : scenario_(std::move(scenario)) {
+    try {
+      simulation_ = std::make_unique<sim::Simulation>(scenario_);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file.string() + ": " + e.what());
+    }
+  }
+  std::string name() const override { return scenario_.name; }
+  int frame_count() const override { return simulation_->frame_count(); }
+  Frame frame(int i) override { return simulation_->render(i); }
+  double ground_z() const override { return scenario_.ground_z; }
+  std::uint64_t seed() const override { return scenario_.seed; }
+  std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
+    return sim::world_triangles(scenario_, t);
+  }
+
+ private:
+  sim::Scenario scenario_;
+  std::unique_ptr<sim::Simulation> simulation_;
+};
+
+// A recorded sequence (depth.txt, groundtruth.txt, depth/*.png, camera.yaml): its poses are
+// what a localisation system gave; the ground is the world's z = 0 plane (as TUM's and ours).
+class RecordedSource final : public FrameSource {
+ public:
+  RecordedSource(const fs::path& dir, int frames) : sequence_(read_tum_sequence(dir)) {
+    if (sequence_.frames.empty()) throw InputError(dir.string() + ": the sequence has no frame with a pose");
+    count_ = static_cast<int>(sequence_.frames.size());
+    if (frames > 0) count_ = std::min(count_, frames);
+  }
+  std::string name() const override {
+    return sequence_.camera.name.empty() ? sequence_.dir.filename().string() : sequence_.camera.name;
+  }
+  int frame_count() const override { return count_; }
+  Frame frame(int i) override { return load_tum_frame(sequence_, static_cast<std::size_t>(i)); }
+  double ground_z() const override { return 0.0; }
+  std::uint64_t seed() const override { return 0; }
+  std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }
+
+ private:
+  TumSequence sequence_;
+  int count_ = 0;
+};
+
 // The sweep renderer, made at the first sweep: BRIRs from --brir, or synthesised for a shoebox
 // room that is the bounding box of the map around the listener (at least 2 x 2 x 2.4 m).
 class SweepMaker {
@@ -235,22 +295,25 @@ RunOutcome run_scenario(const RunOptions& options) {
   RunSettings settings;
   std::vector<std::string> scenario_overrides;
   split_overrides(options.overrides, scenario_overrides, settings);
-  if (options.frames > 0) scenario_overrides.push_back("frames=" + std::to_string(options.frames));
-  if (options.seed) scenario_overrides.push_back("seed=" + std::to_string(*options.seed));
-  sim::Scenario scenario = load_scenario(options.scenario, scenario_overrides);
+  std::unique_ptr<FrameSource> source;
+  if (fs::is_directory(options.scenario)) {
+    if (!scenario_overrides.empty())
+      throw InputError("--set " + scenario_overrides.front() +
+                       ": a recorded sequence has no scenario keys (only run keys apply)");
+    source = std::make_unique<RecordedSource>(options.scenario, options.frames);
+  } else {
+    if (options.frames > 0) scenario_overrides.push_back("frames=" + std::to_string(options.frames));
+    if (options.seed) scenario_overrides.push_back("seed=" + std::to_string(*options.seed));
+    source = std::make_unique<SimulatedSource>(load_scenario(options.scenario, scenario_overrides),
+                                               options.scenario);
+  }
+  const bool has_truth = source->truth(0.0).has_value();
 
   auto mapper = make_mapper(options.mapper, options.voxel, settings.mapper);
   if (!settings.ghost_tolerance_set) {
     // conventions.md: a ghost is more than 2 voxels closer than the truth.
     for (const auto& [key, value] : mapper->config_entries())
       if (key == "global_voxel" || key == "voxel") settings.metrics.ghost_tolerance = 2.0 * std::stod(value);
-  }
-
-  std::unique_ptr<sim::Simulation> simulation;
-  try {
-    simulation = std::make_unique<sim::Simulation>(scenario);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(options.scenario.string() + ": " + e.what());
   }
 
   StagedDirectory staged(options.out);
@@ -273,21 +336,22 @@ RunOutcome run_scenario(const RunOptions& options) {
     cylinder_csv << "frame,row,bin,estimate,truth\n";
   }
 
-  const int frame_count = simulation->frame_count();
+  const int frame_count = source->frame_count();
   const int last_evaluated = frame_count - 1;
   Rasteriser rasteriser(settings.raster);
   std::vector<Eigen::Vector3f> surface;
   MetricSeries circle_series, cylinder_series;
+  int evaluated = 0;
   std::vector<std::string> timing_columns;
   std::map<std::string, std::vector<double>> timing_samples;
   SweepMaker sweeps(options.brir_dir, options.quiet);
-  Progress progress("run " + scenario.name, frame_count, options.quiet);
+  Progress progress("run " + source->name(), frame_count, options.quiet);
 
   for (int i = 0; i < frame_count; ++i) {
     throw_if_interrupted();
     std::vector<std::pair<std::string, double>> times;
     auto t0 = Clock::now();
-    const Frame frame = simulation->render(i);
+    const Frame frame = source->frame(i);
     times.emplace_back("render", ms_since(t0));
 
     t0 = Clock::now();
@@ -303,28 +367,37 @@ RunOutcome run_scenario(const RunOptions& options) {
     const bool evaluate = (i % options.every == 0) || i == last_evaluated;
     if (evaluate) {
       t0 = Clock::now();
-      const RasterOrigin origin = raster_origin(frame.world_T_body, scenario.ground_z);
+      const RasterOrigin origin = raster_origin(frame.world_T_body, source->ground_z());
       surface.clear();
       mapper->surface_points(origin.position, settings.raster.max_range, surface);
       rasteriser.reset(origin);
       rasteriser.add(surface);
       times.emplace_back("raster", ms_since(t0));
 
-      t0 = Clock::now();
-      const RasterOrigin true_origin = raster_origin(frame.world_T_body_true, scenario.ground_z);
-      const GroundTruthRasters truth = ground_truth_rasters(
-          sim::world_triangles(scenario, frame.time), true_origin, settings.raster);
-      times.emplace_back("truth", ms_since(t0));
-
-      const RasterMetrics mc = compare(rasteriser.circle(), truth.circle, settings.metrics);
-      const RasterMetrics my = compare(rasteriser.cylinder(), truth.cylinder, settings.metrics);
-      circle_series.frames.push_back(mc);
-      cylinder_series.frames.push_back(my);
+      // Without ground truth (recorded data) the truth rasters stay unknown and no metric is
+      // computed: the metric columns are left empty.
+      GroundTruthRasters truth{make_circle(settings.raster), make_cylinder(settings.raster)};
+      RasterMetrics mc, my;
+      mc.coverage = mc.rmse = my.coverage = my.rmse = NAN;
+      mc.estimate_known = rasteriser.circle().known_count();
+      my.estimate_known = rasteriser.cylinder().known_count();
+      if (has_truth) {
+        t0 = Clock::now();
+        const RasterOrigin true_origin = raster_origin(frame.world_T_body_true, source->ground_z());
+        truth = ground_truth_rasters(*source->truth(frame.time), true_origin, settings.raster);
+        times.emplace_back("truth", ms_since(t0));
+        mc = compare(rasteriser.circle(), truth.circle, settings.metrics);
+        my = compare(rasteriser.cylinder(), truth.cylinder, settings.metrics);
+        circle_series.frames.push_back(mc);
+        cylinder_series.frames.push_back(my);
+      }
+      ++evaluated;
       frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ','
                  << pose_csv(frame.world_T_body_true) << ',' << csv_number(mc.coverage) << ','
-                 << csv_number(mc.rmse) << ',' << mc.ghosts << ',' << mc.estimate_known << ','
-                 << csv_number(my.coverage) << ',' << csv_number(my.rmse) << ',' << my.ghosts
-                 << ',' << my.estimate_known << '\n';
+                 << csv_number(mc.rmse) << ',' << (has_truth ? std::to_string(mc.ghosts) : "") << ','
+                 << mc.estimate_known << ',' << csv_number(my.coverage) << ',' << csv_number(my.rmse)
+                 << ',' << (has_truth ? std::to_string(my.ghosts) : "") << ',' << my.estimate_known
+                 << '\n';
 
       if (options.write_rasters) {
         const Circle& c = rasteriser.circle();
@@ -339,13 +412,14 @@ RunOutcome run_scenario(const RunOptions& options) {
       }
       if (chosen(options.picture_frames, i, last_evaluated)) {
         const std::string stem = fmt::format("frame_{:06d}", i);
-        plot_circle(dir / "pictures" / (stem + "_circle.png"), rasteriser.circle(), &truth.circle,
+        plot_circle(dir / "pictures" / (stem + "_circle.png"), rasteriser.circle(),
+                    has_truth ? &truth.circle : nullptr,
                     origin, settings.raster,
-                    fmt::format("{}: {} circle, frame {} (t = {:.2f} s)", scenario.name,
+                    fmt::format("{}: {} circle, frame {} (t = {:.2f} s)", source->name(),
                                 mapper->name(), i, frame.time));
         plot_cylinder(dir / "pictures" / (stem + "_cylinder.png"), rasteriser.cylinder(),
                       settings.raster,
-                      fmt::format("{}: {} cylinder, frame {}", scenario.name, mapper->name(), i));
+                      fmt::format("{}: {} cylinder, frame {}", source->name(), mapper->name(), i));
       }
       if (chosen(options.sweep_frames, i, last_evaluated))
         sweeps.write(rasteriser.circle(), surface, origin,
@@ -376,17 +450,19 @@ RunOutcome run_scenario(const RunOptions& options) {
                           {"row_height", settings.raster.row_height},
                           {"max_range", settings.raster.max_range}}},
               {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance}}},
-              {"frames", frame_count}, {"every", options.every}, {"seed", scenario.seed},
+              {"frames", frame_count}, {"every", options.every}, {"seed", source->seed()},
               {"overrides", options.overrides}};
   for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;
 
-  json summary{{"scenario", {{"name", scenario.name}, {"file", options.scenario.string()}}},
-               {"seed", scenario.seed},
+  json summary{{"scenario", {{"name", source->name()}, {"file", options.scenario.string()}}},
+               {"seed", source->seed()},
                {"code_version", code_version()},
-               {"ground_truth", true},
+               {"ground_truth", has_truth},
+               {"ground_truth_note", has_truth ? "exact wedge minima from the scenario's geometry"
+                                               : "recorded data: no ground truth, no metrics"},
                {"config", config},
                {"config_hash", config_hash(config)},
-               {"evaluated_frames", circle_series.frames.size()},
+               {"evaluated_frames", evaluated},
                {"tags", tags},
                {"metrics", {{"circle", circle_series.summary()},
                             {"cylinder", cylinder_series.summary()}}}};
@@ -449,7 +525,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   CLI::App* cmd = app.add_subcommand(
       "run", "Run a scenario through the whole chain (sensor, mapper, rasters, ground truth, "
              "metrics, pictures, sweeps) and write one result directory");
-  cmd->add_option("scenario", options->scenario, "Scenario YAML file")->required();
+  cmd->add_option("scenario", options->scenario,
+                  "Scenario YAML file, or a recorded TUM RGB-D directory (depth.txt, groundtruth.txt,\n"
+                  "depth/*.png, camera.yaml: no ground truth, no metrics)")->required();
   cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
   cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
       ->check(CLI::PositiveNumber);
