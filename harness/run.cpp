@@ -75,6 +75,7 @@ void apply_run_setting(RunSettings& settings, const Setting& s) {
       {"raster.row_height", &settings.raster.row_height},
       {"raster.max_range", &settings.raster.max_range},
       {"metrics.ghost_tolerance", &settings.metrics.ghost_tolerance},
+      {"metrics.edge_jump", &settings.metrics.edge_jump},
   };
   if (auto it = numbers.find(k); it != numbers.end()) {
     *it->second = parse_number(s);
@@ -90,7 +91,8 @@ void apply_run_setting(RunSettings& settings, const Setting& s) {
   }
   throw InputError(s.source + ": unknown key '" + k +
                    "' (run keys: mapper.*, raster.band_min, raster.band_max, raster.row_height, "
-                   "raster.max_range, raster.azimuth_bins, metrics.ghost_tolerance)");
+                   "raster.max_range, raster.azimuth_bins, metrics.ghost_tolerance, "
+                   "metrics.edge_jump)");
 }
 
 // Splits "key=value" overrides into scenario overrides and run settings.
@@ -123,6 +125,7 @@ std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{:.6f}
 json metrics_json(const RasterMetrics& m) {
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   return json{{"coverage", num(m.coverage)}, {"rmse", num(m.rmse)},
+              {"rmse_off_edges", num(m.rmse_off_edges)}, {"edge_cells", m.edge_cells},
               {"ghosts", m.ghosts},          {"known_in_both", m.known_in_both},
               {"truth_occupied", m.truth_occupied}, {"estimate_known", m.estimate_known},
               {"cells", m.cells}};
@@ -132,15 +135,17 @@ json metrics_json(const RasterMetrics& m) {
 struct MetricSeries {
   std::vector<RasterMetrics> frames;
   json summary() const {
-    double cov = 0, rmse = 0, ghosts = 0;
-    int n_cov = 0, n_rmse = 0;
+    double cov = 0, rmse = 0, rmse_off = 0, ghosts = 0;
+    int n_cov = 0, n_rmse = 0, n_off = 0;
     for (const auto& m : frames) {
       if (std::isfinite(m.coverage)) cov += m.coverage, ++n_cov;
       if (std::isfinite(m.rmse)) rmse += m.rmse, ++n_rmse;
+      if (std::isfinite(m.rmse_off_edges)) rmse_off += m.rmse_off_edges, ++n_off;
       ghosts += m.ghosts;
     }
     json mean{{"coverage", n_cov ? json(cov / n_cov) : json(nullptr)},
               {"rmse", n_rmse ? json(rmse / n_rmse) : json(nullptr)},
+              {"rmse_off_edges", n_off ? json(rmse_off / n_off) : json(nullptr)},
               {"ghosts", frames.empty() ? json(nullptr) : json(ghosts / frames.size())}};
     return json{{"final", frames.empty() ? json(nullptr) : metrics_json(frames.back())},
                 {"mean", mean}};
@@ -327,8 +332,9 @@ RunOutcome run_scenario(const RunOptions& options) {
   std::ofstream frames_csv(dir / "frames.csv"), timings_csv(dir / "timings.csv");
   std::ofstream circle_csv, cylinder_csv;
   frames_csv << "frame,time,x,y,z,heading_deg,"
-                "circle_coverage,circle_rmse,circle_ghosts,circle_known,"
-                "cylinder_coverage,cylinder_rmse,cylinder_ghosts,cylinder_known\n";
+                "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
+                "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
+                "cylinder_known\n";
   if (options.write_rasters) {
     circle_csv.open(dir / "circle.csv");
     cylinder_csv.open(dir / "cylinder.csv");
@@ -393,11 +399,12 @@ RunOutcome run_scenario(const RunOptions& options) {
       }
       ++evaluated;
       frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ','
-                 << pose_csv(frame.world_T_body_true) << ',' << csv_number(mc.coverage) << ','
-                 << csv_number(mc.rmse) << ',' << (has_truth ? std::to_string(mc.ghosts) : "") << ','
-                 << mc.estimate_known << ',' << csv_number(my.coverage) << ',' << csv_number(my.rmse)
-                 << ',' << (has_truth ? std::to_string(my.ghosts) : "") << ',' << my.estimate_known
-                 << '\n';
+                 << pose_csv(frame.world_T_body_true);
+      for (const RasterMetrics* m : {&mc, &my})
+        frames_csv << ',' << csv_number(m->coverage) << ',' << csv_number(m->rmse) << ','
+                   << csv_number(m->rmse_off_edges) << ','
+                   << (has_truth ? std::to_string(m->ghosts) : "") << ',' << m->estimate_known;
+      frames_csv << '\n';
 
       if (options.write_rasters) {
         const Circle& c = rasteriser.circle();
@@ -449,7 +456,8 @@ RunOutcome run_scenario(const RunOptions& options) {
                           {"band_max", settings.raster.band_max},
                           {"row_height", settings.raster.row_height},
                           {"max_range", settings.raster.max_range}}},
-              {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance}}},
+              {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance},
+                           {"edge_jump", settings.metrics.edge_jump}}},
               {"frames", frame_count}, {"every", options.every}, {"seed", source->seed()},
               {"overrides", options.overrides}};
   for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;

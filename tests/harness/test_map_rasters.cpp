@@ -58,44 +58,8 @@ sim::Scenario turning_in_a_room(sim::NoiseSpec::Model noise) {
   return s;
 }
 
-// RMSE over the bins known in both whose truth has no silhouette edge: a truth range that jumps
-// by more than 0.25 m to a neighbouring bin. There a sub-degree sliver of a near object decides
-// the bin's truth (a box corner 0.01 degrees into a bin at 1.3 m is 0.2 mm of surface), which
-// no map with centimetre voxels resolves; one such bin of 1.4 m error alone makes an RMSE of
-// 7.5 cm over 360 bins. The test counts those bins separately.
-struct InteriorRmse {
-  double rmse = 0.0;
-  int edge_bins = 0;
-};
-
-InteriorRmse interior_rmse(const Circle& estimate, const Circle& truth) {
-  InteriorRmse out;
-  double sum = 0.0;
-  int n = 0;
-  const int bins = truth.size();
-  for (int k = 0; k < bins; ++k) {
-    const RasterCell& t = truth.bins[k];
-    const RasterCell& e = estimate.bins[k];
-    if (!t.known() || !e.known()) continue;
-    bool edge = false;
-    for (int neighbour : {(k + bins - 1) % bins, (k + 1) % bins}) {
-      const RasterCell& tn = truth.bins[neighbour];
-      edge = edge || !tn.known() || std::abs(tn.range - t.range) > 0.25;
-    }
-    if (edge) {
-      ++out.edge_bins;
-      continue;
-    }
-    sum += (e.range - t.range) * (e.range - t.range);
-    ++n;
-  }
-  out.rmse = n ? std::sqrt(sum / n) : NAN;
-  return out;
-}
-
 struct Evaluation {
   harness::RasterMetrics circle, cylinder;
-  InteriorRmse interior;
 };
 
 Evaluation evaluate(Mapper& mapper, const sim::Scenario& s, const Frame& frame) {
@@ -111,8 +75,7 @@ Evaluation evaluate(Mapper& mapper, const sim::Scenario& s, const Frame& frame) 
   harness::MetricsConfig metrics;
   metrics.ghost_tolerance = 0.10;
   return {harness::compare(rasteriser.circle(), truth.circle, metrics),
-          harness::compare(rasteriser.cylinder(), truth.cylinder, metrics),
-          interior_rmse(rasteriser.circle(), truth.circle)};
+          harness::compare(rasteriser.cylinder(), truth.cylinder, metrics)};
 }
 
 Evaluation map_full_turn(Mapper& mapper, sim::NoiseSpec::Model noise) {
@@ -133,12 +96,14 @@ TEST_CASE("after a full turn in a room the VDB-GPDF circle covers every bin with
   VdbGpdf mapper;  // reference defaults: 5 cm global voxels
   const Evaluation e = map_full_turn(mapper, sim::NoiseSpec::Model::None);
   INFO("circle coverage " << e.circle.coverage << ", RMSE " << e.circle.rmse << " m, ghosts "
-                          << e.circle.ghosts << ", RMSE off silhouette edges " << e.interior.rmse
-                          << " m, edge bins " << e.interior.edge_bins);
+                          << e.circle.ghosts << ", RMSE off silhouette edges " << e.circle.rmse_off_edges
+                          << " m, edge bins " << e.circle.edge_cells);
   CHECK(e.circle.truth_occupied == 360);
   CHECK(e.circle.coverage == 1.0);
-  CHECK(e.interior.edge_bins <= 8);  // the box's two silhouettes and the room's corners
-  CHECK(e.interior.rmse < 0.5 * 0.05);
+  // The RMSE over every bin is dominated by silhouette slivers (harness/metrics.hpp); the
+  // surfaces themselves are measured off the truth's silhouette edges.
+  CHECK(e.circle.edge_cells <= 8);  // the box's two silhouettes
+  CHECK(e.circle.rmse_off_edges < 0.5 * 0.05);
   CHECK(e.circle.ghosts == 0);
 }
 
@@ -146,16 +111,16 @@ TEST_CASE("with Kinect noise the VDB-GPDF circle still covers every bin within o
           "[map][raster][noise]") {
   VdbGpdf mapper;
   const Evaluation e = map_full_turn(mapper, sim::NoiseSpec::Model::Kinect);
-  INFO("circle coverage " << e.circle.coverage << ", RMSE off silhouette edges " << e.interior.rmse);
+  INFO("circle coverage " << e.circle.coverage << ", RMSE off silhouette edges " << e.circle.rmse_off_edges);
   CHECK(e.circle.coverage == 1.0);
-  CHECK(e.interior.rmse < 0.05);
+  CHECK(e.circle.rmse_off_edges < 0.05);
 }
 
 TEST_CASE("after a full turn the TSDF peer's circle covers every bin within one voxel",
           "[map][raster][tsdf]") {
   Tsdf mapper;
   const Evaluation e = map_full_turn(mapper, sim::NoiseSpec::Model::None);
-  INFO("circle coverage " << e.circle.coverage << ", RMSE off silhouette edges " << e.interior.rmse);
+  INFO("circle coverage " << e.circle.coverage << ", RMSE off silhouette edges " << e.circle.rmse_off_edges);
   CHECK(e.circle.coverage == 1.0);
-  CHECK(e.interior.rmse < 0.05);
+  CHECK(e.circle.rmse_off_edges < 0.05);
 }

@@ -101,3 +101,21 @@ TEST_CASE("Rasters of different shapes are not compared", "[metrics]") {
   negative.ghost_tolerance = -0.1;
   CHECK_THROWS_AS(compare(Circle(360), Circle(360), negative), std::invalid_argument);
 }
+
+TEST_CASE("a silhouette sliver counts in the RMSE but not in the RMSE off edges", "[metrics]") {
+  // Truth: a wall at 2 m in every bin but bins 10..19, where a box stands at 1 m. Bins 9, 10, 19
+  // and 20 sit on the box's silhouette (a 1 m jump to a neighbour). The estimate is right
+  // everywhere except bin 10, which reads the wall (a sliver of the box the map missed), and
+  // bin 15, 3 cm long.
+  Circle truth(360), estimate(360);
+  for (int k = 0; k < 360; ++k) {
+    truth.bins[k].range = (k >= 10 && k < 20) ? 1.0f : 2.0f;
+    estimate.bins[k].range = truth.bins[k].range;
+  }
+  estimate.bins[10].range = 2.0f;
+  estimate.bins[15].range = 1.03f;
+  const RasterMetrics m = compare(estimate, truth);
+  CHECK(m.edge_cells == 4);
+  CHECK(m.rmse == Approx(std::sqrt((1.0 + 0.03 * 0.03) / 360.0)).epsilon(1e-5));
+  CHECK(m.rmse_off_edges == Approx(std::sqrt(0.03 * 0.03 / 356.0)).epsilon(1e-4));
+}
