@@ -157,7 +157,7 @@ int build_report(const fs::path& dir, bool quiet) {
   csv << "run,scenario,variant,mapper,voxel,seed,frames";
   for (const char* raster : {"circle", "cylinder"})
     for (const char* which : {"final", "mean"})
-      for (const char* name : {"coverage", "rmse", "ghosts"})
+      for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
         csv << ',' << raster << '_' << which << '_' << name;
   for (const auto& s : stages) csv << ",median_" << s << "_ms";
   csv << '\n';
@@ -167,7 +167,8 @@ int build_report(const fs::path& dir, bool quiet) {
         << r.summary["config"].value("frames", 0);
     for (const char* raster : {"circle", "cylinder"})
       for (const char* which : {"final", "mean"})
-        for (const char* name : {"coverage", "rmse", "ghosts"}) csv << ',' << value(r, raster, which, name);
+        for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
+          csv << ',' << value(r, raster, which, name);
     for (const auto& s : stages) csv << ',' << median(r, s);
     csv << '\n';
   }
@@ -210,6 +211,8 @@ int build_report(const fs::path& dir, bool quiet) {
     const std::vector<std::pair<std::string, std::string>> series = {
         {"circle_coverage", "circle coverage"}, {"cylinder_coverage", "cylinder coverage"},
         {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
+        {"circle_rmse_off_edges", "circle RMSE off silhouette edges (m)"},
+        {"cylinder_rmse_off_edges", "cylinder RMSE off silhouette edges (m)"},
         {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"}};
     for (const auto& [column, label] : series) {
       const std::string name = scenario + "_" + column + ".png";
