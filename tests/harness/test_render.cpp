@@ -164,7 +164,7 @@ TEST_CASE("render never replaces a directory that is not a sequence", "[render][
   CHECK(text_of(keep) == "mine");
 }
 
-TEST_CASE("16-bit PNGs round-trip every value; other files are clear errors", "[render]") {
+TEST_CASE("16-bit PNGs round-trip every value, other files are clear errors", "[render]") {
   ScratchDir dir("render");
   sonomap::harness::DepthImage16 image;
   image.width = 300;
