@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// compare: every combination of a sweep file is an independent run; the report rolls up what
+// exists; a rerun skips finished runs; the job list is one command per run.
+#include "cli_support.hpp"
+#include "test_scenario_files.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+int line_count(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
+std::string tiny_sweep() {
+  return "name: tiny\n"
+         "frames: 3\n"
+         "set: [sensor.width=160, sensor.height=120, sensor.intrinsics.fx=131.25,\n"
+         "      sensor.intrinsics.fy=131.25, sensor.intrinsics.cx=79.5, sensor.intrinsics.cy=59.5]\n"
+         "scenarios:\n"
+         "  - {id: smoke, file: " + sonomap::test::shipped("scenes/smoke.yaml").string() + "}\n"
+         "variants:\n"
+         "  - {id: depth, mapper: depth_only}\n"
+         "  - {id: tsdf10, mapper: tsdf, voxel: 0.1}\n"
+         "pictures: [-1]\n"
+         "sweeps: [-1]\n";
+}
+
+}  // namespace
+
+TEST_CASE("a sweep runs each variant once, rolls them up, and a rerun skips finished runs",
+          "[compare]") {
+  sonomap::test::ScratchDir scratch("compare");
+  const fs::path sweep = scratch.write("sweep.yaml", tiny_sweep());
+  const fs::path out = scratch.path() / "out";
+
+  const auto jobs = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", out.string(), "--emit-jobs"});
+  REQUIRE(jobs.status == 0);
+  CHECK(line_count(jobs.output) == 2);
+  CHECK(!fs::exists(out / "runs"));  // emitting jobs runs nothing
+
+  const auto first = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", out.string(), "-j", "2"});
+  INFO(first.output);
+  REQUIRE(first.status == 0);
+  CHECK(fs::exists(out / "runs" / "smoke-depth-s1" / "summary.json"));
+  CHECK(fs::exists(out / "runs" / "smoke-tsdf10-s1" / "summary.json"));
+  CHECK(line_count(sonomap::test::text_of(out / "rollup.csv")) == 1 + 2);
+  CHECK(sonomap::test::text_of(out / "report.md").find("smoke-tsdf10-s1") != std::string::npos);
+
+  const auto second = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", out.string()});
+  CHECK(second.status == 0);
+  CHECK(second.output.find("2 finished before, 0 to run") != std::string::npos);
+}
+
+TEST_CASE("a sweep file with an unknown key is rejected with its line", "[compare]") {
+  sonomap::test::ScratchDir scratch("compare-bad");
+  const fs::path sweep = scratch.write("sweep.yaml", tiny_sweep() + "varaints: []\n");
+  const auto r = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", (scratch.path() / "out").string()});
+  CHECK(r.status == 2);
+  CHECK(r.output.find("sweep.yaml:12") != std::string::npos);
+  CHECK(r.output.find("varaints") != std::string::npos);
+  CHECK(!fs::exists(scratch.path() / "out"));
+}
