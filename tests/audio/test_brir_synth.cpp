@@ -100,7 +100,7 @@ TEST_CASE("synthetic BRIR: RT60 by Schroeder integration within 10% of the targe
   CHECK(schroeder_rt60(banded.left) < 0.65);
 }
 
-TEST_CASE("direct sound falls 6 dB per doubling of distance; the D/R ratio falls too", "[room]") {
+TEST_CASE("direct sound falls 6 dB per doubling of distance, the D/R ratio falls too", "[room]") {
   BrirSynthConfig config;
   config.rt60 = 0.4;
   config.max_order = 2;

@@ -145,7 +145,7 @@ TEST_CASE("The heading rotates the bins: ahead of the body is bin 0 whatever the
   CHECK(thirty.circle().bins[15].range == Approx(2.0).epsilon(1e-6));
 }
 
-TEST_CASE("Each cell keeps the closest point; the cylinder keeps it per row", "[rasteriser]") {
+TEST_CASE("Each cell keeps the closest point, the cylinder keeps it per row", "[rasteriser]") {
   Rasteriser r = at_origin();
   r.add(polar(10.5, 3.0, 0.55));  // row 4
   r.add(polar(10.5, 2.0, 1.55));  // row 14, closer

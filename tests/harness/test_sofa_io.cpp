@@ -69,7 +69,7 @@ TEST_CASE("SOFA round trip: written with netCDF, loaded by libmysofa, samples eq
   fs::remove_all(dir);
 }
 
-TEST_CASE("a BRIR directory round trip keeps the grid and every sample; rates are converted",
+TEST_CASE("a BRIR directory round trip keeps the grid and every sample, rates are converted",
           "[sofa]") {
   const fs::path dir = fresh_dir("dir");
   const auto grid = audio::BrirGrid::paper();

@@ -145,7 +145,7 @@ TEST_CASE("sonify refuses bad circles and BRIR directories: exit 2, no WAV", "[c
   fs::remove_all(dir);
 }
 
-TEST_CASE("brir writes the paper's grid that sonify then loads; without --brir a room is "
+TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a room is "
           "synthesised in memory",
           "[cli][brir]") {
   const fs::path dir = fresh_dir("brir");

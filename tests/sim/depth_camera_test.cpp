@@ -177,7 +177,7 @@ TEST_CASE("frames carry the time step and the true poses", "[sim][camera]") {
   CHECK(depth_at(f, 320, 240) == Approx(1.8).epsilon(1e-5));
 }
 
-TEST_CASE("an empty world returns nothing; a lone mover is still seen", "[sim][camera][moving]") {
+TEST_CASE("an empty world returns nothing, a lone mover is still seen", "[sim][camera][moving]") {
   Scenario s;
   s.body = test::still(Eigen::Vector3d(0.0, 0.0, 1.0));
   s.camera.width = 64;

@@ -126,7 +126,7 @@ TEST_CASE("edge, grazing and dropout invalidation", "[sim][noise]") {
   CHECK(zeros / 40000.0 == Approx(0.3).margin(0.01));
 }
 
-TEST_CASE("model None gives exact depth; Kinect stays near the truth", "[sim][noise]") {
+TEST_CASE("model None gives exact depth, Kinect stays near the truth", "[sim][noise]") {
   Scenario s = test::wall_scenario(2.5);
   s.camera.width = 160;
   s.camera.height = 120;

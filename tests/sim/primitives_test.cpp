@@ -25,7 +25,7 @@ PrimitiveSpec shape(PrimitiveSpec::Kind kind) {
 
 }  // namespace
 
-TEST_CASE("box stands on z = 0, centred in x and y, normals out; room faces in", "[sim][primitives]") {
+TEST_CASE("box stands on z = 0, centred in x and y, normals out, room faces in", "[sim][primitives]") {
   PrimitiveSpec box = shape(PrimitiveSpec::Kind::Box);
   box.size = Eigen::Vector3d(2.0, 3.0, 4.0);
   const TriangleMesh m = triangulate(box);
