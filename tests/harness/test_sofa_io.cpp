@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // SOFA files: what we write, libmysofa loads back sample for sample; measured HRIR sets load;
 // malformed files end in a clear error, never a crash.
+#include "test_scenario_files.hpp"
 #include "harness/errors.hpp"
 #include "harness/sofa_io.hpp"
 
@@ -22,14 +23,6 @@ using namespace sonomap::harness;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() /
-                     ("sonomap_test_sofa_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
 // A set whose samples are all different (seeded), so a transposed or shifted read shows.
 audio::BrirSet random_set(double rate, const std::vector<double>& azimuths,
                           const std::vector<double>& distances, size_t length) {
@@ -45,7 +38,8 @@ audio::BrirSet random_set(double rate, const std::vector<double>& azimuths,
 }  // namespace
 
 TEST_CASE("SOFA round trip: written with netCDF, loaded by libmysofa, samples equal", "[sofa]") {
-  const fs::path dir = fresh_dir("roundtrip");
+  const sonomap::test::ScratchDir scratch("sofa-roundtrip");
+  const fs::path& dir = scratch.path();
   const std::vector<double> azimuths{-177.0, -90.0, 0.0, 3.0, 90.0, 180.0};
   const audio::BrirSet set = random_set(48000.0, azimuths, {1.2}, 300);
   std::vector<audio::BinauralIr> irs;
@@ -71,7 +65,8 @@ TEST_CASE("SOFA round trip: written with netCDF, loaded by libmysofa, samples eq
 
 TEST_CASE("a BRIR directory round trip keeps the grid and every sample, rates are converted",
           "[sofa]") {
-  const fs::path dir = fresh_dir("dir");
+  const sonomap::test::ScratchDir scratch("sofa-dir");
+  const fs::path& dir = scratch.path();
   const auto grid = audio::BrirGrid::paper();
   const std::vector<double> azimuths{-90.0, 0.0, 90.0, 180.0};
   const audio::BrirSet set = random_set(48000.0, azimuths, grid.distances_m, 64);
@@ -97,7 +92,8 @@ TEST_CASE("a BRIR directory round trip keeps the grid and every sample, rates ar
 }
 
 TEST_CASE("bad BRIR directories: empty, a missing distance, a mixed sample rate", "[sofa]") {
-  const fs::path dir = fresh_dir("bad");
+  const sonomap::test::ScratchDir scratch("sofa-bad");
+  const fs::path& dir = scratch.path();
   fs::create_directories(dir / "empty");
   CHECK_THROWS_WITH(read_brir_directory(dir / "empty", 48000.0), Catch::Contains("no .sofa files"));
   const auto grid = audio::BrirGrid::paper();

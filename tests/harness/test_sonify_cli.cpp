@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `sonomap sonify` and `sonomap brir` end to end: outputs on success; on bad input a clear
 // message, exit status 2 and no WAV (not even a partial one).
+#include "test_scenario_files.hpp"
 #include "harness/circle_io.hpp"
 #include "harness/errors.hpp"
 #include "harness/sofa_io.hpp"
@@ -19,14 +20,6 @@ using namespace sonomap;
 using namespace sonomap::harness;
 
 namespace {
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() /
-                     ("sonomap_test_sonify_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 struct Result {
   int status;
@@ -75,7 +68,8 @@ bool only_inputs_left(const fs::path& dir) {
 }  // namespace
 
 TEST_CASE("sonify writes a 48 kHz stereo sweep and its event log", "[cli][sonify]") {
-  const fs::path dir = fresh_dir("ok");
+  const sonomap::test::ScratchDir scratch("sonify-ok");
+  const fs::path& dir = scratch.path();
   write_impulse_brirs(dir / "brirs");
   std::ofstream(dir / "circle.csv") << circle_text(360, "0.8");
   const Result r = run("-q sonify " + (dir / "circle.csv").string() + " --out " +
@@ -104,7 +98,8 @@ TEST_CASE("sonify writes a 48 kHz stereo sweep and its event log", "[cli][sonify
 }
 
 TEST_CASE("sonify refuses bad circles and BRIR directories: exit 2, no WAV", "[cli][sonify]") {
-  const fs::path dir = fresh_dir("bad");
+  const sonomap::test::ScratchDir scratch("sonify-bad");
+  const fs::path& dir = scratch.path();
   write_impulse_brirs(dir / "brirs");
   const std::string out = " --out " + (dir / "sweep.wav").string();
   const std::string brirs = " --brir " + (dir / "brirs").string();
@@ -148,7 +143,8 @@ TEST_CASE("sonify refuses bad circles and BRIR directories: exit 2, no WAV", "[c
 TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a room is "
           "synthesised in memory",
           "[cli][brir]") {
-  const fs::path dir = fresh_dir("brir");
+  const sonomap::test::ScratchDir scratch("sonify-brir");
+  const fs::path& dir = scratch.path();
   Result r = run("-q brir --room 5x4x3 --rt60 0.2 --order 0 --ir-length 0.02 --out " +
                      (dir / "set").string(),
                  dir);
