@@ -10,13 +10,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/stopwatch.hpp"
+
 namespace sonomap {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using Clock = StageClock;
 constexpr float kUnobservedDistance = -100.0f;
 }  // namespace
 

@@ -2,6 +2,7 @@
 #include "harness/run.hpp"
 
 #include "core/rasteriser.hpp"
+#include "core/stopwatch.hpp"
 #include "harness/errors.hpp"
 #include "harness/ground_truth.hpp"
 #include "harness/interrupt.hpp"
@@ -34,10 +35,7 @@ using nlohmann::json;
 namespace sonomap::harness {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+using Clock = StageClock;
 
 // Run keys (everything that is not part of the scenario file).
 struct RunSettings {
