@@ -125,14 +125,7 @@ Timing time_frames(const sim::Scenario& scenario, const std::vector<int>& frames
 
   sim::Simulation simulation(scenario);
   sim::World world(simulation.scenario());
-  const sim::CameraSpec& camera = scenario.camera;
-  sim::PinholeRays rays;
-  rays.width = camera.width;
-  rays.height = camera.height;
-  rays.fx = camera.fx;
-  rays.fy = camera.fy;
-  rays.cx = camera.cx;
-  rays.cy = camera.cy;
+  sim::PinholeRays rays = sim::PinholeRays::of(scenario.camera, Eigen::Isometry3d::Identity());
 
   simulation.render(frames.front());  // warm-up: first-touch allocations and TBB workers
   std::vector<double> rays_ms, rays_cpu_ms, render_ms, render_cpu_ms;

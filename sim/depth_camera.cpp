@@ -11,15 +11,7 @@ namespace sonomap::sim {
 DepthCamera::DepthCamera(const CameraSpec& spec) : spec_(spec) { validate(spec_); }
 
 DepthImage DepthCamera::trace(const World& world, const Eigen::Isometry3d& world_T_camera) const {
-  PinholeRays rays;
-  rays.world_T_camera = world_T_camera;
-  rays.width = spec_.width;
-  rays.height = spec_.height;
-  rays.fx = spec_.fx;
-  rays.fy = spec_.fy;
-  rays.cx = spec_.cx;
-  rays.cy = spec_.cy;
-  const RayHits hits = world.cast(rays);
+  const RayHits hits = world.cast(PinholeRays::of(spec_, world_T_camera));
 
   DepthImage image;
   image.width = spec_.width;

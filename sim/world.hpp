@@ -18,6 +18,19 @@ struct PinholeRays {
   int width = 0;
   int height = 0;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+
+  // The rays of a camera's pixels from a pose.
+  static PinholeRays of(const CameraSpec& camera, const Eigen::Isometry3d& world_T_camera) {
+    PinholeRays rays;
+    rays.world_T_camera = world_T_camera;
+    rays.width = camera.width;
+    rays.height = camera.height;
+    rays.fx = camera.fx;
+    rays.fy = camera.fy;
+    rays.cx = camera.cx;
+    rays.cy = camera.cy;
+    return rays;
+  }
 };
 
 // Per ray (row-major), what it hit first.
