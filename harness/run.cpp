@@ -290,6 +290,14 @@ class SweepMaker {
 
 }  // namespace
 
+void rasterise_map(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& rasteriser,
+                   std::vector<Eigen::Vector3f>& surface) {
+  surface.clear();
+  mapper.surface_points(origin.position, rasteriser.config().max_range, surface);
+  rasteriser.reset(origin);
+  rasteriser.add(surface);
+}
+
 RunOutcome run_scenario(const RunOptions& options) {
   if (options.frames < 0) throw InputError("--frames must be positive, got " + std::to_string(options.frames));
   if (options.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(options.every));
@@ -372,10 +380,7 @@ RunOutcome run_scenario(const RunOptions& options) {
     if (evaluate) {
       t0 = Clock::now();
       const RasterOrigin origin = raster_origin(frame.world_T_body, source->ground_z());
-      surface.clear();
-      mapper->surface_points(origin.position, settings.raster.max_range, surface);
-      rasteriser.reset(origin);
-      rasteriser.add(surface);
+      rasterise_map(*mapper, origin, rasteriser, surface);
       times.emplace_back("raster", ms_since(t0));
 
       // Without ground truth (recorded data) the truth rasters stay unknown and no metric is

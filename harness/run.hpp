@@ -15,6 +15,8 @@
 //   map.ply        the mapper's final surface mesh (mappers that have one)
 #pragma once
 
+#include "core/mapper.hpp"
+#include "core/rasteriser.hpp"
 #include "harness/cli.hpp"
 
 #include <nlohmann/json.hpp>
@@ -56,6 +58,12 @@ struct RunOutcome {
 };
 
 RunOutcome run_scenario(const RunOptions& options);
+
+// The map's circle and cylinder around `origin`, as a run builds them: the mapper's surface
+// samples within the raster's max_range, added to the rasteriser reset on `origin`. `surface`
+// is reused scratch and holds those samples afterwards. (`bench map` times this same call.)
+void rasterise_map(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& rasteriser,
+                   std::vector<Eigen::Vector3f>& surface);
 
 // A one-screen summary of a run, for the terminal.
 std::string summary_screen(const RunOutcome& outcome);
