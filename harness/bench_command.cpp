@@ -86,18 +86,6 @@ sim::Scenario builtin_room() {
   return s;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
-double process_cpu_ms() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
 // Wall time and CPU time (all threads) of one call, in ms. On a busy machine the CPU time of
 // the one-thread run is the better estimate of the wall time on an idle core.
 template <typename F>
@@ -205,6 +193,7 @@ void add_bench_command(CLI::App& app, const GlobalOptions& global) {
   bench->require_subcommand(1);
   add_bench_render(*bench, global);
   add_bench_sonify(*bench, global);
+  add_bench_map(*bench, global);
 }
 
 }  // namespace sonomap::harness

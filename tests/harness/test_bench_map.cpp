@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `sonomap bench map` end to end on the smoke scene: every mapper has every stage timed, the
+// Open3D reference surface lies where our TSDF's does (an independent implementation, same
+// frames), and bad input exits 2 writing nothing. No timing is asserted.
+#include "cli_support.hpp"
+#include "test_scenario_files.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using sonomap::test::run_sonomap;
+
+namespace {
+
+std::vector<std::string> bench_map_arguments(const fs::path& json_file) {
+  return {"-q", "bench", "map", sonomap::test::shipped("scenes/smoke.yaml").string(), "--frames", "3",
+          "--voxels", "0.1", "--threads-list", "1", "--json", json_file.string()};
+}
+
+}  // namespace
+
+TEST_CASE("bench map times every stage of every mapper and Open3D's surface agrees with the TSDF's",
+          "[cli][bench]") {
+  const sonomap::test::ScratchDir scratch("bench-map");
+  const fs::path file = scratch.path() / "bench.json";
+  const auto result = run_sonomap(bench_map_arguments(file));
+  INFO(result.output);
+  REQUIRE(result.status == 0);
+  const json bench = json::parse(sonomap::test::text_of(file));
+
+  // The stages: VDB-GPDF's own, the rasters of our maps, and the whole frame.
+  const std::map<std::string, std::set<std::string>> expected{
+      {"vdb_gpdf", {"local_gps", "query_points", "fusion", "g_gpdf", "raster", "map", "frame"}},
+      {"tsdf", {"raster", "map", "frame"}},
+      {"open3d", {"convert", "integrate", "map", "frame"}}};
+  std::set<std::string> seen;
+  for (const json& row : bench.at("results")) {
+    const std::string mapper = row.at("mapper");
+    INFO("mapper " << mapper);
+    seen.insert(mapper);
+    CHECK(row.at("voxel").get<double>() == Approx(0.1));
+    CHECK(row.at("threads").get<int>() == 1);
+    CHECK(row.at("frames").get<int>() == 3);
+    CHECK(row.at("peak_map_bytes").get<double>() > 0);
+    for (const std::string& stage : expected.at(mapper)) CHECK(row.at("median_ms").contains(stage));
+    for (const auto& [stage, ms] : row.at("median_ms").items()) {
+      INFO("stage " << stage);
+      CHECK(std::isfinite(ms.get<double>()));
+      CHECK(ms.get<double>() > 0.0);
+    }
+    // Open3D is its own reference; the others are compared with it.
+    if (mapper != "open3d") CHECK(row.at("frame_ratio_to_open3d").get<double>() > 0.0);
+  }
+  CHECK(seen == std::set<std::string>{"vdb_gpdf", "tsdf", "open3d"});
+
+  // Same frames, same poses, an independent TSDF: Open3D's mesh vertices lie on our TSDF's
+  // surface to well within a voxel (a wrong extrinsic or axis convention puts them metres off).
+  REQUIRE(bench.at("open3d_checks").size() == 1);
+  const json& check = bench.at("open3d_checks")[0];
+  CHECK(check.at("open3d_vertices").get<int>() > 1000);
+  CHECK(check.at("median_distance_m").get<double>() < 0.1);
+  CHECK(bench.at("peak_rss_mb").get<double>() > 0.0);
+}
+
+TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0 and no frames, writing nothing",
+          "[cli][bench]") {
+  const sonomap::test::ScratchDir scratch("bench-map-bad");
+  const fs::path file = scratch.path() / "bench.json";
+  const auto with = [&](const std::string& option, const std::string& value) {
+    auto arguments = bench_map_arguments(file);
+    const auto it = std::find(arguments.begin(), arguments.end(), option);
+    REQUIRE(it != arguments.end());
+    *(it + 1) = value;
+    return run_sonomap(arguments);
+  };
+  const auto unknown = [&] {
+    auto arguments = bench_map_arguments(file);
+    arguments.insert(arguments.end(), {"--mappers", "vdb_gpdf,octomap"});
+    return run_sonomap(arguments);
+  }();
+  CHECK(unknown.status == 2);
+  CHECK_THAT(unknown.output, Catch::Contains("octomap"));
+  const auto zero_voxel = with("--voxels", "0.1,0");
+  CHECK(zero_voxel.status == 2);
+  CHECK_THAT(zero_voxel.output, Catch::Contains("--voxels"));
+  const auto no_frames = with("--frames", "0");
+  CHECK(no_frames.status == 2);
+  CHECK_THAT(no_frames.output, Catch::Contains("--frames"));
+  CHECK(sonomap::test::nothing_written(file));
+}
