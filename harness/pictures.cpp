@@ -3,6 +3,7 @@
 
 #include "harness/subprocess.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -125,6 +126,82 @@ void plot_circle(const fs::path& png, const Circle& estimate, const Circle* trut
      << "     $truth using 1:2 with lines lw 1.5 lc rgb 'black' title 'ground truth', \\\n"
      << "     $points using 1:2:3 with points pt 7 ps 0.7 lc palette title 'closest points'\n";
 
+  draw_with_gnuplot(png, gp.str());
+}
+
+void plot_edf_arrows(const fs::path& png, const Circle& map_circle, const EdfRaster& edf,
+                     const RasterOrigin& origin, const RasterConfig& config,
+                     const std::string& title, double arrow_step_deg) {
+  const int bins = map_circle.size();
+  if (bins == 0 || static_cast<int>(edf.bins.size()) != bins || edf.traced.size() != bins)
+    throw std::invalid_argument("plot_edf_arrows: the map circle and the EDF circle differ in bins");
+  const int stride = std::max(1, static_cast<int>(std::lround(arrow_step_deg * bins / 360.0)));
+  // World direction -> display (body frame: x ahead is up, y left is left).
+  const double c = std::cos(-origin.heading), s = std::sin(-origin.heading);
+  auto display = [&](double wx, double wy, double& dx, double& dy) {
+    const double bx = c * wx - s * wy, by = s * wx + c * wy;
+    dx = -by;
+    dy = bx;
+  };
+  const double extent = config.max_range * 1.1;
+  std::ostringstream gp;
+  gp.precision(6);
+  gp << "set terminal pngcairo size 1600,820 noenhanced font 'DejaVu Sans,11'\n"
+     << "set output " << quoted(png.string()) << "\n"
+     << "set size ratio -1\nset grid\n"
+     << "set xrange [" << -extent << ":" << extent << "]\nset yrange [" << -extent << ":" << extent << "]\n"
+     << "set xlabel 'right (m)   [left is left, ahead is up]'\nset ylabel 'ahead (m)'\n"
+     << "set object 1 circle at 0,0 size 0.08 fc rgb 'black' fs solid front\n";
+  gp << "$rays << EOD\n";
+  for (int k = 0; k < bins; k += stride) {
+    const RasterCell& cell = map_circle.bins[k];
+    if (!cell.known()) continue;
+    double x, y;
+    to_display(map_circle.bin_centre_deg(k), cell.range, x, y);
+    gp << "0 0 " << x << ' ' << y << '\n';
+  }
+  gp << "EOD\n$ring << EOD\n";
+  for (int k = 0; k < bins; ++k) {
+    if (!map_circle.bins[k].known()) continue;
+    double x, y;
+    to_display(map_circle.bin_centre_deg(k), map_circle.bins[k].range, x, y);
+    gp << x << ' ' << y << '\n';
+  }
+  gp << "EOD\n$arrows << EOD\n";
+  for (int k = 0; k < bins; k += stride) {
+    const EdfBin& b = edf.bins[k];
+    if (!b.sample_observed) continue;
+    double x, y, dx, dy;
+    display(b.sample_point.x() - origin.position.x(), b.sample_point.y() - origin.position.y(), x, y);
+    display(b.sample_distance * b.closest_direction.x(), b.sample_distance * b.closest_direction.y(), dx, dy);
+    gp << x << ' ' << y << ' ' << dx << ' ' << dy << '\n';
+  }
+  gp << "EOD\n$samples << EOD\n";
+  for (const EdfBin& b : edf.bins) {
+    double x, y;
+    display(b.sample_point.x() - origin.position.x(), b.sample_point.y() - origin.position.y(), x, y);
+    gp << x << ' ' << y << ' ' << (b.sample_observed ? 1 : 0) << '\n';
+  }
+  gp << "EOD\n$traced << EOD\n";
+  for (int k = 0; k < bins; ++k) {
+    if (!edf.traced.bins[k].known()) continue;
+    double x, y;
+    to_display(edf.traced.bin_centre_deg(k), edf.traced.bins[k].range, x, y);
+    gp << x << ' ' << y << '\n';
+  }
+  gp << "EOD\n"
+     << "set multiplot layout 1,2 title " << quoted(title) << "\n"
+     << "set title 'circle: the closest range along each bearing (rays)'\n"
+     << "plot $ring using 1:2 with points pt 7 ps 0.5 lc rgb 'black' title 'map circle', \\\n"
+     << "     $rays using 1:2:3:4 with vectors head filled size 0.08,20 lw 1.5 lc rgb '#2166ac' "
+        "title 'ray bearings'\n"
+     << "set title 'EDF: distance and direction to the closest surface (-gradient)'\n"
+     << "plot $traced using 1:2 with points pt 7 ps 0.5 lc rgb '#999999' title 'sphere-traced ranges', \\\n"
+     << "     $samples using 1:2:($3 > 0 ? 0x000000 : 0xcccccc) with points pt 7 ps 0.4 lc rgb variable "
+        "title 'query points', \\\n"
+     << "     $arrows using 1:2:3:4 with vectors head filled size 0.08,20 lw 1.5 lc rgb '#2166ac' "
+        "title 'gradient bearings'\n"
+     << "unset multiplot\n";
   draw_with_gnuplot(png, gp.str());
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/run.hpp"
 
+#include "core/edf_raster.hpp"
 #include "core/rasteriser.hpp"
 #include "core/stopwatch.hpp"
 #include "harness/errors.hpp"
@@ -43,10 +44,15 @@ struct RunSettings {
   MetricsConfig metrics;
   bool ghost_tolerance_set = false;
   std::vector<Setting> mapper;
+  // The EDF comparison (edf.*): on by default, every `edf_every`-th evaluated frame.
+  bool edf_enabled = true;
+  int edf_every = 1;
+  EdfRasterConfig edf;
+  bool edf_max_range_set = false;  // otherwise the raster's max_range
 };
 
 bool is_run_key(const std::string& key) {
-  for (const char* prefix : {"mapper.", "raster.", "metrics."})
+  for (const char* prefix : {"mapper.", "raster.", "metrics.", "edf."})
     if (key.rfind(prefix, 0) == 0) return true;
   return false;
 }
@@ -74,10 +80,29 @@ void apply_run_setting(RunSettings& settings, const Setting& s) {
       {"raster.max_range", &settings.raster.max_range},
       {"metrics.ghost_tolerance", &settings.metrics.ghost_tolerance},
       {"metrics.edge_jump", &settings.metrics.edge_jump},
+      {"edf.sample_radius", &settings.edf.sample_radius},
+      {"edf.hit_tolerance", &settings.edf.hit_tolerance},
+      {"edf.max_range", &settings.edf.max_range},
   };
   if (auto it = numbers.find(k); it != numbers.end()) {
     *it->second = parse_number(s);
     if (k == "metrics.ghost_tolerance") settings.ghost_tolerance_set = true;
+    if (k == "edf.max_range") settings.edf_max_range_set = true;
+    if (k.rfind("edf.", 0) == 0 && !(*it->second > 0.0))
+      throw InputError(s.source + ": key '" + k + "': expected a number > 0, got '" + s.value + "'");
+    return;
+  }
+  if (k == "edf.max_steps" || k == "edf.every") {
+    const double v = parse_number(s);
+    if (v != std::floor(v) || v < 1 || v > 1e6)
+      throw InputError(s.source + ": key '" + k + "': expected a whole number in [1, 1000000]");
+    (k == "edf.every" ? settings.edf_every : settings.edf.max_steps) = static_cast<int>(v);
+    return;
+  }
+  if (k == "edf.enabled") {
+    if (s.value != "true" && s.value != "false")
+      throw InputError(s.source + ": key '" + k + "': expected true or false, got '" + s.value + "'");
+    settings.edf_enabled = s.value == "true";
     return;
   }
   if (k == "raster.azimuth_bins") {
@@ -90,7 +115,8 @@ void apply_run_setting(RunSettings& settings, const Setting& s) {
   throw InputError(s.source + ": unknown key '" + k +
                    "' (run keys: mapper.*, raster.band_min, raster.band_max, raster.row_height, "
                    "raster.max_range, raster.azimuth_bins, metrics.ghost_tolerance, "
-                   "metrics.edge_jump)");
+                   "metrics.edge_jump, edf.enabled, edf.every, edf.sample_radius, "
+                   "edf.hit_tolerance, edf.max_steps, edf.max_range)");
 }
 
 // Splits "key=value" overrides into scenario overrides and run settings.
@@ -110,6 +136,12 @@ void split_overrides(const std::vector<std::string>& overrides, std::vector<std:
     settings.raster.validate();
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--set raster.*: ") + e.what());
+  }
+  if (!settings.edf_max_range_set) settings.edf.max_range = settings.raster.max_range;
+  try {
+    settings.edf.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--set edf.*: ") + e.what());
   }
 }
 
@@ -149,6 +181,27 @@ struct MetricSeries {
                 {"mean", mean}};
   }
 };
+
+json slip_json(const SlipStats& s) {
+  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  return json{{"median_deg", num(s.median_deg)}, {"p90_deg", num(s.p90_deg)}, {"observed", s.observed}};
+}
+
+// Per bin of the final frame: the map's circle next to the EDF's (edf.csv, README.md).
+void write_edf_csv(const fs::path& file, int frame, const Circle& map_circle, const EdfRaster& edf,
+                   const Circle& truth) {
+  std::ofstream out(file);
+  out << "frame,bin,azimuth_deg,map_range,edf_distance,slip_deg,traced_range,truth,trace_end\n";
+  for (int k = 0; k < map_circle.size(); ++k) {
+    const EdfBin& b = edf.bins[k];
+    out << frame << ',' << k << ',' << fmt::format("{:.4f}", map_circle.bin_centre_deg(k)) << ','
+        << csv_range(map_circle.bins[k]) << ',' << csv_number(b.sample_distance) << ','
+        << csv_number(b.slip_deg) << ',' << csv_range(edf.traced.bins[k]) << ','
+        << csv_range(truth.bins[k]) << ',' << trace_end_name(b.end) << '\n';
+  }
+  out.close();
+  if (out.fail()) throw std::runtime_error("writing " + file.string() + " failed");
+}
 
 bool chosen(const std::vector<int>& list, int frame, int last_evaluated) {
   if (list.empty()) return frame == last_evaluated;
@@ -340,7 +393,8 @@ RunOutcome run_scenario(const RunOptions& options) {
   frames_csv << "frame,time,x,y,z,heading_deg,"
                 "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
                 "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
-                "cylinder_known\n";
+                "cylinder_known,edf_coverage,edf_rmse,edf_rmse_off_edges,edf_ghosts,edf_known,"
+                "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known\n";
   if (options.write_rasters) {
     circle_csv.open(dir / "circle.csv");
     cylinder_csv.open(dir / "cylinder.csv");
@@ -352,7 +406,8 @@ RunOutcome run_scenario(const RunOptions& options) {
   const int last_evaluated = frame_count - 1;
   Rasteriser rasteriser(settings.raster);
   std::vector<Eigen::Vector3f> surface;
-  MetricSeries circle_series, cylinder_series;
+  MetricSeries circle_series, cylinder_series, edf_series;
+  std::vector<SlipStats> slip_series;
   int evaluated = 0;
   std::vector<std::string> timing_columns;
   std::map<std::string, std::vector<double>> timing_samples;
@@ -400,6 +455,32 @@ RunOutcome run_scenario(const RunOptions& options) {
         circle_series.frames.push_back(mc);
         cylinder_series.frames.push_back(my);
       }
+      // The EDF comparison (edf.*): every edf.every-th evaluated frame, the last and the
+      // pictured ones. A mapper without a field gets an all-unknown EDF circle, not a guess.
+      const bool picture = chosen(options.picture_frames, i, last_evaluated);
+      std::optional<EdfRaster> edf;
+      RasterMetrics me;
+      SlipStats slip;
+      if (settings.edf_enabled &&
+          (evaluated % settings.edf_every == 0 || i == last_evaluated || picture)) {
+        t0 = Clock::now();
+        try {
+          edf = edf_raster(*mapper, origin, settings.raster.azimuth_bins, settings.edf);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(fmt::format("frame {} (t = {:.3f} s): {}", i, frame.time, e.what()));
+        }
+        times.emplace_back("edf", ms_since(t0));
+        slip = slip_stats(*edf);
+        slip_series.push_back(slip);
+        me.coverage = me.rmse = me.rmse_off_edges = NAN;
+        me.estimate_known = edf->traced.known_count();
+        if (has_truth) {
+          me = compare(edf->traced, truth.circle, settings.metrics);
+          edf_series.frames.push_back(me);
+        }
+        if (i == last_evaluated)
+          write_edf_csv(dir / "edf.csv", i, rasteriser.circle(), *edf, truth.circle);
+      }
       ++evaluated;
       frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ','
                  << pose_csv(frame.world_T_body_true);
@@ -407,6 +488,14 @@ RunOutcome run_scenario(const RunOptions& options) {
         frames_csv << ',' << csv_number(m->coverage) << ',' << csv_number(m->rmse) << ','
                    << csv_number(m->rmse_off_edges) << ','
                    << (has_truth ? std::to_string(m->ghosts) : "") << ',' << m->estimate_known;
+      if (edf)
+        frames_csv << ',' << csv_number(me.coverage) << ',' << csv_number(me.rmse) << ','
+                   << csv_number(me.rmse_off_edges) << ','
+                   << (has_truth ? std::to_string(me.ghosts) : "") << ',' << me.estimate_known
+                   << ',' << csv_number(slip.median_deg) << ',' << csv_number(slip.p90_deg) << ','
+                   << slip.observed;
+      else
+        frames_csv << ",,,,,,,,";
       frames_csv << '\n';
 
       if (options.write_rasters) {
@@ -430,6 +519,11 @@ RunOutcome run_scenario(const RunOptions& options) {
         plot_cylinder(dir / "pictures" / (stem + "_cylinder.png"), rasteriser.cylinder(),
                       settings.raster,
                       fmt::format("{}: {} cylinder, frame {}", source->name(), mapper->name(), i));
+        if (edf)
+          plot_edf_arrows(dir / "pictures" / (stem + "_edf.png"), rasteriser.circle(), *edf, origin,
+                          settings.raster,
+                          fmt::format("{}: {} circle vs EDF, frame {} (slip median {:.1f} deg)",
+                                      source->name(), mapper->name(), i, slip.median_deg));
       }
       if (chosen(options.sweep_frames, i, last_evaluated))
         sweeps.write(rasteriser.circle(), surface, origin,
@@ -461,6 +555,11 @@ RunOutcome run_scenario(const RunOptions& options) {
                           {"max_range", settings.raster.max_range}}},
               {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance},
                            {"edge_jump", settings.metrics.edge_jump}}},
+              {"edf", {{"enabled", settings.edf_enabled}, {"every", settings.edf_every},
+                       {"sample_radius", settings.edf.sample_radius},
+                       {"hit_tolerance", settings.edf.hit_tolerance},
+                       {"max_steps", settings.edf.max_steps},
+                       {"max_range", settings.edf.max_range}}},
               {"frames", frame_count}, {"every", options.every}, {"seed", source->seed()},
               {"overrides", options.overrides}};
   for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;
@@ -477,6 +576,18 @@ RunOutcome run_scenario(const RunOptions& options) {
                {"tags", tags},
                {"metrics", {{"circle", circle_series.summary()},
                             {"cylinder", cylinder_series.summary()}}}};
+  if (settings.edf_enabled) {
+    // The EDF circle's metrics sit beside the map's; the slip (no truth needed) in "edf".
+    summary["metrics"]["edf_circle"] = edf_series.summary();
+    double median = 0.0, p90 = 0.0;
+    int n = 0;
+    for (const SlipStats& s : slip_series)
+      if (s.observed > 0) median += s.median_deg, p90 += s.p90_deg, ++n;
+    summary["edf"] = {{"frames", slip_series.size()},
+                      {"slip", {{"final", slip_series.empty() ? json(nullptr) : slip_json(slip_series.back())},
+                                {"mean", {{"median_deg", n ? json(median / n) : json(nullptr)},
+                                          {"p90_deg", n ? json(p90 / n) : json(nullptr)}}}}}};
+  }
 
   json timings = json::object();
   for (auto& [name, samples] : timing_samples) {
@@ -527,6 +638,14 @@ std::string summary_screen(const RunOutcome& outcome) {
                         metric(raster, "final", "coverage"), metric(raster, "final", "rmse"),
                         metric(raster, "final", "ghosts"), metric(raster, "mean", "coverage"),
                         metric(raster, "mean", "rmse"));
+  if (s.contains("edf") && !s["edf"]["slip"]["final"].is_null()) {
+    const json& slip = s["edf"]["slip"]["final"];
+    auto deg = [](const json& v) { return v.is_null() ? std::string("-") : fmt::format("{:.1f} deg", v.get<double>()); };
+    text += fmt::format("  {:<10} {:>10} {:>10} {:>8}   EDF bearing slip: median {}, p90 {}\n",
+                        "edf circle", metric("edf_circle", "final", "coverage"),
+                        metric("edf_circle", "final", "rmse"), metric("edf_circle", "final", "ghosts"),
+                        deg(slip["median_deg"]), deg(slip["p90_deg"]));
+  }
   text += fmt::format("  results: {}\n", outcome.dir.string());
   return text;
 }
@@ -550,7 +669,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--voxel", options->voxel, "Global voxel size in metres (default: the mapper's)");
   cmd->add_option("--seed", options->seed, "Run seed (overrides the scenario's)");
   cmd->add_option("--set", options->overrides,
-                  "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*)");
+                  "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*, edf.*)");
   cmd->add_option("--pictures", options->picture_frames,
                   "Frames to draw (default: the last; -1: none)");
   cmd->add_option("--sweeps", options->sweep_frames,

@@ -9,6 +9,7 @@
 //   timings.csv    one row per frame: wall time of each stage in ms (the only file that varies)
 //   circle.csv     frame,bin,estimate,truth (unknown = empty field)
 //   cylinder.csv   frame,row,bin,estimate,truth
+//   edf.csv        the final frame's EDF comparison per bin (run keys edf.*; core/edf_raster.hpp)
 //   pictures/      frame_NNNNNN_circle.png, frame_NNNNNN_cylinder.png
 //   sweeps/        frame_NNNNNN.wav, frame_NNNNNN.events.csv (circular ranging of the map's
 //                  circle), room.json (the room the BRIRs were synthesised for)
@@ -32,7 +33,7 @@ namespace sonomap::harness {
 struct RunOptions {
   std::filesystem::path scenario;  // YAML scenario, or a TUM RGB-D directory (recorded data)
   // "key=value": scenario keys (see scenes/README.md) and run keys: mapper.*, raster.*,
-  // metrics.*, sonify.* (see README.md).
+  // metrics.*, edf.*, sonify.* (see README.md).
   std::vector<std::string> overrides;
   std::filesystem::path out;
   int frames = 0;  // 0: as the scenario says

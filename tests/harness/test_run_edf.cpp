@@ -1,0 +1,255 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `sonomap run`'s EDF comparison (edf.* keys, edf.csv, the edf_* columns, summary entries):
+// on the smoke room the field's bearings slip far off the rays, while its sphere-traced ranges
+// meet the true surfaces; the truth is an exact ray cast against the scene's own triangles.
+#include "test_scenario_files.hpp"
+
+#include "harness/errors.hpp"
+#include "harness/run.hpp"
+#include "harness/scenario_yaml.hpp"
+#include "sim/world_geometry.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using sonomap::test::ScratchDir;
+
+namespace {
+
+std::vector<std::string> small_camera() {
+  return {"sensor.width=320", "sensor.height=240", "sensor.intrinsics.fx=262.5",
+          "sensor.intrinsics.fy=262.5", "sensor.intrinsics.cx=159.5", "sensor.intrinsics.cy=119.5"};
+}
+
+sonomap::harness::RunOptions smoke(const fs::path& out, const std::string& mapper, int frames) {
+  sonomap::harness::RunOptions o;
+  o.scenario = sonomap::test::shipped("scenes/smoke.yaml");
+  o.out = out;
+  o.mapper = mapper;
+  o.frames = frames;
+  o.overrides = small_camera();
+  o.picture_frames = {-1};
+  o.sweep_frames = {-1};
+  o.write_rasters = false;
+  o.quiet = true;
+  return o;
+}
+
+// A CSV file as rows of named fields.
+std::vector<std::map<std::string, std::string>> read_csv(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+  auto split = [](const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream ss(line);
+    for (std::string field; std::getline(ss, field, ',');) out.push_back(field);
+    if (!line.empty() && line.back() == ',') out.emplace_back();
+    return out;
+  };
+  for (std::string line; std::getline(in, line);) {
+    if (header.empty()) {
+      header = split(line);
+      continue;
+    }
+    const auto fields = split(line);
+    REQUIRE(fields.size() == header.size());
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < header.size(); ++i) row[header[i]] = fields[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+json summary_of(const fs::path& dir) {
+  std::ifstream in(dir / "summary.json");
+  return json::parse(in);
+}
+
+// Nearest hit t > 0 of o + t d on a triangle (Moeller-Trumbore), or +inf.
+double ray_hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const sonomap::sim::WorldTriangle& tri) {
+  const Eigen::Vector3d e1 = tri[1] - tri[0], e2 = tri[2] - tri[0];
+  const Eigen::Vector3d p = d.cross(e2);
+  const double det = e1.dot(p);
+  if (std::abs(det) < 1e-12) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d s = o - tri[0];
+  const double u = s.dot(p) / det;
+  if (u < 0.0 || u > 1.0) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = d.dot(q) / det;
+  if (v < 0.0 || u + v > 1.0) return std::numeric_limits<double>::infinity();
+  const double t = e2.dot(q) / det;
+  return t > 1e-9 ? t : std::numeric_limits<double>::infinity();
+}
+
+// Exact distance from p to a triangle (closest point by Voronoi regions, Ericson 5.1.5).
+double distance_to(const Eigen::Vector3d& p, const sonomap::sim::WorldTriangle& tri) {
+  const Eigen::Vector3d &a = tri[0], &b = tri[1], &c = tri[2];
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+}  // namespace
+
+TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges meet the surfaces",
+          "[run][edf]") {
+  ScratchDir scratch("run-edf");
+  auto o = smoke(scratch.path() / "out", "vdb_gpdf", 30);
+  o.every = 10;                // frames 0, 10, 20 and 29
+  o.picture_frames = {29};     // the arrows picture of the last frame
+  sonomap::harness::run_scenario(o);
+  const fs::path dir = o.out;
+  CHECK(fs::is_regular_file(dir / "pictures" / "frame_000029_edf.png"));
+
+  const auto frames = read_csv(dir / "frames.csv");
+  REQUIRE(frames.size() == 4);
+  for (const auto& f : frames) {
+    INFO("frame " << f.at("frame"));
+    CHECK(!f.at("edf_known").empty());
+    CHECK(!f.at("edf_coverage").empty());
+  }
+  const json summary = summary_of(dir);
+  REQUIRE(summary.contains("edf"));
+  CHECK(summary["edf"]["frames"] == 4);
+  const json& slip = summary["edf"]["slip"]["final"];
+  REQUIRE(slip["median_deg"].is_number());
+  // Several surfaces round the listener: the closest one is rarely the one along the ray, so
+  // the median direction to it is far off the bearing (0 would mean a field that follows
+  // the rays, as the circle does).
+  CHECK(slip["median_deg"].get<double>() > 20.0);
+  CHECK(slip["p90_deg"].get<double>() >= slip["median_deg"].get<double>());
+  CHECK(summary["metrics"]["edf_circle"]["final"]["coverage"].get<double>() > 0.1);
+
+  // The final frame per bin, against the scene's true triangles (exact poses: no localisation
+  // noise). Sphere tracing stops within the hit tolerance of a surface, so every hit point is
+  // that close to a true surface (plus the map's error, a voxel); where the ray does not just
+  // graze an object on its way, that is where the bin's ray at the sensor's height meets it.
+  const auto bins = read_csv(dir / "edf.csv");
+  REQUIRE(bins.size() == 360);
+  const auto& last = frames.back();
+  const Eigen::Vector3d eye(std::stod(last.at("x")), std::stod(last.at("y")), std::stod(last.at("z")));
+  const double heading = std::stod(last.at("heading_deg")) * M_PI / 180.0;
+  const auto scenario = sonomap::harness::load_scenario(o.scenario, small_camera());
+  const auto triangles = sonomap::sim::world_triangles(scenario, std::stod(last.at("time")));
+  const double voxel = 0.05;  // VDB-GPDF's default global voxel
+  const double hit_tolerance = summary["config"]["edf"]["hit_tolerance"].get<double>();
+  int hits = 0, along_ray = 0, slips_known = 0;
+  for (int k = 0; k < 360; ++k) {
+    const auto& b = bins[static_cast<size_t>(k)];
+    CHECK(std::stoi(b.at("bin")) == k);
+    if (!b.at("slip_deg").empty()) {
+      ++slips_known;
+      CHECK(std::stod(b.at("slip_deg")) >= 0.0);
+      CHECK(std::stod(b.at("slip_deg")) <= 180.0);
+    }
+    if (b.at("trace_end") != "hit") {
+      CHECK(b.at("traced_range").empty());  // unknown, never a guessed range
+      continue;
+    }
+    ++hits;
+    const double a = heading + (k + 0.5) * M_PI / 180.0;
+    const Eigen::Vector3d ray(std::cos(a), std::sin(a), 0.0);
+    double exact = std::numeric_limits<double>::infinity();
+    for (const auto& tri : triangles) exact = std::min(exact, ray_hit(eye, ray, tri));
+    const double traced = std::stod(b.at("traced_range"));
+    double off_surface = std::numeric_limits<double>::infinity();
+    for (const auto& tri : triangles) off_surface = std::min(off_surface, distance_to(eye + traced * ray, tri));
+    INFO("bin " << k << ": traced " << traced << " m, exact ray hit " << exact
+                << " m, hit point " << off_surface << " m off the nearest surface");
+    CHECK(off_surface <= hit_tolerance + voxel);
+    if (std::abs(traced - exact) <= voxel) ++along_ray;
+  }
+  CHECK(slips_known == slip["observed"].get<int>());
+  CHECK(hits > 60);
+  CHECK(along_ray >= hits * 4 / 5);  // measured 2026-11-22: 89 of 95
+}
+
+TEST_CASE("EDF with a depth-only mapper: no field, so everything EDF is unknown", "[run][edf]") {
+  ScratchDir scratch("run-edf-depth-only");
+  auto o = smoke(scratch.path() / "out", "depth_only", 3);
+  sonomap::harness::run_scenario(o);
+  const auto bins = read_csv(o.out / "edf.csv");
+  REQUIRE(bins.size() == 360);
+  int map_known = 0;
+  for (const auto& b : bins) {
+    map_known += !b.at("map_range").empty();  // the map's own circle is there ...
+    CHECK(b.at("edf_distance").empty());       // ... the field's values are not
+    CHECK(b.at("slip_deg").empty());
+    CHECK(b.at("traced_range").empty());
+    CHECK(b.at("trace_end") == "unobserved");
+  }
+  CHECK(map_known > 0);
+  const json summary = summary_of(o.out);
+  CHECK(summary["edf"]["slip"]["final"]["median_deg"].is_null());
+  CHECK(summary["edf"]["slip"]["final"]["observed"] == 0);
+  CHECK(summary["metrics"]["edf_circle"]["final"]["estimate_known"] == 0);
+  CHECK(summary["metrics"]["edf_circle"]["final"]["rmse"].is_null());
+  CHECK(summary["metrics"]["circle"]["final"]["estimate_known"].get<int>() > 0);
+}
+
+TEST_CASE("edf.every, edf.enabled and bad edf keys", "[run][edf][bad_input]") {
+  ScratchDir scratch("run-edf-keys");
+  SECTION("edf.every=3: EDF columns on evaluated frames 0, 3, 6 (6 is the last) only") {
+    auto o = smoke(scratch.path() / "out", "depth_only", 7);
+    o.overrides.push_back("edf.every=3");
+    sonomap::harness::run_scenario(o);
+    const auto frames = read_csv(o.out / "frames.csv");
+    REQUIRE(frames.size() == 7);
+    for (const auto& f : frames) {
+      const int i = std::stoi(f.at("frame"));
+      INFO("frame " << i);
+      CHECK(f.at("edf_known").empty() == (i % 3 != 0));
+    }
+    CHECK(summary_of(o.out)["edf"]["frames"] == 3);
+  }
+  SECTION("edf.enabled=false: no edf.csv, empty columns, no summary entry") {
+    auto o = smoke(scratch.path() / "out", "depth_only", 2);
+    o.overrides.push_back("edf.enabled=false");
+    sonomap::harness::run_scenario(o);
+    CHECK_FALSE(fs::exists(o.out / "edf.csv"));
+    for (const auto& f : read_csv(o.out / "frames.csv")) CHECK(f.at("edf_slip_median_deg").empty());
+    const json summary = summary_of(o.out);
+    CHECK_FALSE(summary.contains("edf"));
+    CHECK_FALSE(summary["metrics"].contains("edf_circle"));
+    CHECK(summary["config"]["edf"]["enabled"] == false);
+  }
+  for (const std::string bad : {"edf.sample_radius=0", "edf.hit_tolerance=-1", "edf.max_steps=2.5",
+                                "edf.every=0", "edf.enabled=yes", "edf.max_range=nan", "edf.radius=1"}) {
+    DYNAMIC_SECTION("bad key " << bad) {
+      auto o = smoke(scratch.path() / "bad", "depth_only", 2);
+      o.overrides.push_back(bad);
+      try {
+        sonomap::harness::run_scenario(o);
+        FAIL("no error for --set " << bad);
+      } catch (const sonomap::harness::InputError& e) {
+        const std::string key = bad.substr(0, bad.find('='));
+        CHECK(std::string(e.what()).find(key) != std::string::npos);
+      }
+      CHECK_FALSE(fs::exists(o.out));
+    }
+  }
+}
