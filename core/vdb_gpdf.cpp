@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "core/vdb_gpdf.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <tbb/blocked_range.h>
@@ -21,6 +22,7 @@ namespace {
 using Clock = StageClock;
 
 constexpr float kUnobservedDistance = -100.0f;
+constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("VdbGpdfConfig: " + what);
@@ -82,6 +84,43 @@ struct LocalGps {
     return best;
   }
 };
+
+// Per local voxel: the sum of the frame's points in it (x, y, z) and their count (w).
+using PointSumGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
+
+Eigen::Vector3d centroid(const openvdb::Vec4f& sum) {
+  return Eigen::Vector3d(sum[0], sum[1], sum[2]) / sum[3];
+}
+
+// The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
+// centroids of the occupied local voxels within two voxels of p's (up to 125, about 25 on a
+// plane). Returns zero where the neighbourhood is too small for a plane.
+// (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
+// views that point can still lie behind the sampled surface, the gradient then points into the
+// object, and front points land inside it: measured 13 cm deep in a box.)
+Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const openvdb::Coord& c,
+                               const Eigen::Vector3d& p, const Eigen::Vector3d& u) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  int count = 0;
+  for (int dx = -2; dx <= 2; ++dx)
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dz = -2; dz <= 2; ++dz) {
+        openvdb::Vec4f cell;
+        if (!local.probeValue(c.offsetBy(dx, dy, dz), cell)) continue;
+        const Eigen::Vector3d d = centroid(cell) - p;  // relative to p: well conditioned
+        sum += d;
+        outer += d * d.transpose();
+        ++count;
+      }
+  if (count < 5) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d mean = sum / count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count - mean * mean.transpose());
+  Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
+  if (eig.info() != Eigen::Success || !n.allFinite()) return Eigen::Vector3d::Zero();
+  n.normalize();
+  return n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
 
 }  // namespace
 
@@ -161,10 +200,15 @@ void VdbGpdf::integrate(const Frame& frame) {
 
   // 1. Local grid and one GP per leaf (trained in parallel; each writes only its own slot).
   auto t0 = Clock::now();
-  openvdb::MaskGrid local(false);
+  // Training points are the centroids of the frame's points per local voxel, not the voxel
+  // centres: centres put a face up to half a local voxel inside or outside the object.
+  PointSumGrid local(openvdb::Vec4f(0.0f));
   {
     auto acc = local.getAccessor();
-    for (const auto& p : points) acc.setValueOn(voxel_of(p, config_.local_voxel));
+    for (const auto& p : points) {
+      const openvdb::Coord c = voxel_of(p, config_.local_voxel);
+      acc.setValue(c, acc.getValue(c) + openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f));
+    }
   }
   LocalGps locals;
   locals.voxel = config_.local_voxel;
@@ -174,7 +218,7 @@ void VdbGpdf::integrate(const Frame& frame) {
     int i = 0;
     for (auto v = leaf->cbeginValueOn(); v; ++v, ++i)
       if (i % config_.voxel_downsample == 0)
-        pts.push_back(voxel_centre(v.getCoord(), config_.local_voxel).cast<float>());
+        pts.push_back(centroid(*v).cast<float>());
     locals.index.emplace(leaf->origin(), static_cast<int>(locals.origins.size()));
     locals.origins.push_back(leaf->origin());
     locals.centres.push_back(leaf_centre(leaf->origin(), config_.local_voxel));
@@ -196,6 +240,7 @@ void VdbGpdf::integrate(const Frame& frame) {
   std::vector<std::vector<QueryUpdate>> updates(training.size());
   parallel_for_each_index(training.size(), [&](size_t leaf) {
     auto observed = grid_->getConstAccessor();
+    auto local_acc = local.getConstAccessor();
     auto& out = updates[leaf];
     const double vg = config_.global_voxel;
     // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
@@ -228,27 +273,24 @@ void VdbGpdf::integrate(const Frame& frame) {
       const double range = u.norm();
       if (!(range > 0.0)) continue;
       u /= range;  // toward the sensor: the direction the query points are placed along
-      // The surface normal (toward free space) from the local GP one step in front of p;
-      // where that has no gradient, the ray direction.
-      Eigen::Vector3d normal = u;
-      {
-        const Eigen::Vector3d q = p + config_.query_step * u;
-        const int gp = locals.nearest(q);
-        const GpPrediction pred = gp >= 0 ? locals.gps[gp].predict(q, false) : GpPrediction{};
-        if (pred.valid && pred.gradient.allFinite() && pred.gradient.dot(u) > 0.1)
-          normal = pred.gradient;
-      }
+      const Eigen::Vector3d normal =
+          surface_normal(local_acc, voxel_of(p, config_.local_voxel), p, u);
       {
         const int gp = locals.nearest(p);
         const GpPrediction pred = locals.gps[gp].predict(p, config_.inverse_variance_fusion);
         const double d = pred.valid ? pred.distance : 0.0;
-        fuse(p, -d, -normal, pred.valid ? pred.variance : config_.variance_on_surface);
+        fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
+             pred.valid ? pred.variance : config_.variance_on_surface);
       }
-      // Along the normal, not the ray: behind points along a grazing ray leave thin objects.
-      for (int j = 1; j <= config_.trunc_behind; ++j)
-        fuse_query(p - j * config_.query_step * normal, 1.0);
+      // Behind points along the normal, not the ray (behind points along a grazing ray leave
+      // thin objects), and only where the normal is trusted: a view within 6 degrees of the
+      // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
+      if (normal.dot(u) > kMinNormalDotRay)
+        for (int j = 1; j <= config_.trunc_behind; ++j)
+          fuse_query(p - j * config_.query_step * normal, 1.0);
+      // Front points along the ray: the ray crossed that space, so it is free for sure.
       for (int j = 1; j <= config_.trunc_front; ++j)
-        fuse_query(p + j * config_.query_step * normal, -1.0);
+        fuse_query(p + j * config_.query_step * u, -1.0);
       if (!config_.free_space_carving) continue;
       // One carving point per global voxel the ray crosses (DDA, mid-segment), from one
       // carving step in front of p to the sensor: fixed steps along fixed rays (a static
