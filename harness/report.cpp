@@ -75,6 +75,8 @@ std::string number(const json& v, const char* format = "{:.4f}") {
 
 const json& metric(const RunRecord& r, const char* raster, const char* which) {
   static const json null;
+  // Runs without a raster (edf_circle before the EDF comparison, or with edf.enabled=false).
+  if (!r.summary.contains("metrics") || !r.summary["metrics"].contains(raster)) return null;
   const json& m = r.summary["metrics"][raster];
   return m.contains(which) && !m[which].is_null() ? m[which] : null;
 }
@@ -82,6 +84,23 @@ const json& metric(const RunRecord& r, const char* raster, const char* which) {
 std::string value(const RunRecord& r, const char* raster, const char* which, const char* name) {
   const json& m = metric(r, raster, which);
   return m.is_object() && m.contains(name) ? number(m[name]) : "";
+}
+
+// Table cells: coverage in percent, RMSE in metres, "-" when undefined.
+std::string coverage_cell(const RunRecord& r, const char* raster, const char* which) {
+  const std::string v = value(r, raster, which, "coverage");
+  return v.empty() ? std::string("-") : fmt::format("{:.1f}%", 100 * std::stod(v));
+}
+std::string rmse_cell(const RunRecord& r, const char* raster, const char* which) {
+  const std::string v = value(r, raster, which, "rmse");
+  return v.empty() ? std::string("-") : fmt::format("{:.3f}", std::stod(v));
+}
+
+// The EDF's bearing slip (summary "edf"."slip"), `which` = final or mean; "" when absent.
+std::string slip(const RunRecord& r, const char* which, const char* name) {
+  if (!r.summary.contains("edf") || !r.summary["edf"].is_object()) return "";
+  const json s = r.summary["edf"].value("slip", json::object());
+  return s.contains(which) && s[which].is_object() && s[which].contains(name) ? number(s[which][name], "{:.2f}") : "";
 }
 
 std::vector<std::string> stage_names(const std::vector<RunRecord>& runs) {
@@ -155,20 +174,24 @@ int build_report(const fs::path& dir, bool quiet) {
   // rollup.csv: one row per run.
   std::ostringstream csv;
   csv << "run,scenario,variant,mapper,voxel,seed,frames";
-  for (const char* raster : {"circle", "cylinder"})
+  for (const char* raster : {"circle", "cylinder", "edf_circle"})
     for (const char* which : {"final", "mean"})
       for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
         csv << ',' << raster << '_' << which << '_' << name;
+  for (const char* which : {"final", "mean"})
+    for (const char* name : {"median_deg", "p90_deg"}) csv << ",edf_slip_" << which << '_' << name;
   for (const auto& s : stages) csv << ",median_" << s << "_ms";
   csv << '\n';
   for (const RunRecord& r : runs) {
     csv << r.id << ',' << r.scenario << ',' << r.variant << ',' << r.mapper << ','
         << (std::isfinite(r.voxel) ? fmt::format("{}", r.voxel) : "") << ',' << r.seed << ','
         << r.summary["config"].value("frames", 0);
-    for (const char* raster : {"circle", "cylinder"})
+    for (const char* raster : {"circle", "cylinder", "edf_circle"})
       for (const char* which : {"final", "mean"})
         for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
           csv << ',' << value(r, raster, which, name);
+    for (const char* which : {"final", "mean"})
+      for (const char* name : {"median_deg", "p90_deg"}) csv << ',' << slip(r, which, name);
     for (const auto& s : stages) csv << ',' << median(r, s);
     csv << '\n';
   }
@@ -191,14 +214,8 @@ int build_report(const fs::path& dir, bool quiet) {
           "cylinder ghosts (final) | integrate ms (median) |\n"
        << "|---|---|---|---|---|---|---|---|---|---|\n";
     for (const RunRecord* r : list) {
-      auto pct = [&](const char* raster, const char* which) {
-        const std::string v = value(*r, raster, which, "coverage");
-        return v.empty() ? std::string("-") : fmt::format("{:.1f}%", 100 * std::stod(v));
-      };
-      auto rmse = [&](const char* raster, const char* which) {
-        const std::string v = value(*r, raster, which, "rmse");
-        return v.empty() ? std::string("-") : fmt::format("{:.3f}", std::stod(v));
-      };
+      auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
+      auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
       md << "| " << r->id << " | " << r->mapper << " | "
          << (std::isfinite(r->voxel) ? fmt::format("{}", r->voxel) : "-") << " | "
          << pct("circle", "final") << " / " << pct("circle", "mean") << " | " << rmse("circle", "final")
@@ -208,6 +225,31 @@ int build_report(const fs::path& dir, bool quiet) {
          << value(*r, "cylinder", "final", "ghosts") << " | " << median(*r, "integrate") << " |\n";
     }
     md << "\n";
+    if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return r->summary.contains("edf"); })) {
+      // The paper's "Compare to EDF": the field's direction to the closest surface against each
+      // bin's bearing, and the circle the EDF gives by sphere tracing, beside the map's circle.
+      md << "### Compare to EDF\n\n"
+         << "Bearing slip: angle between the direction to the closest surface (the EDF's "
+            "-gradient at the bin's point on the sample circle) and the bin's ray, degrees, over "
+            "the bins where the field is observed. EDF circle: ranges sphere-traced in the field "
+            "along each bin's ray at the sensor's height.\n\n"
+         << "| run | mapper | slip median / p90 (final) | slip median / p90 (mean) | "
+            "EDF circle cov. (final / mean) | EDF circle RMSE (final / mean) | "
+            "map circle cov. / RMSE (final) |\n"
+         << "|---|---|---|---|---|---|---|\n";
+      auto or_dash = [](const std::string& v) { return v.empty() ? std::string("-") : v; };
+      for (const RunRecord* r : list) {
+        auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
+        auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
+        md << "| " << r->id << " | " << r->mapper << " | " << or_dash(slip(*r, "final", "median_deg"))
+           << " / " << or_dash(slip(*r, "final", "p90_deg")) << " | "
+           << or_dash(slip(*r, "mean", "median_deg")) << " / " << or_dash(slip(*r, "mean", "p90_deg"))
+           << " | " << pct("edf_circle", "final") << " / " << pct("edf_circle", "mean") << " | "
+           << rmse("edf_circle", "final") << " / " << rmse("edf_circle", "mean") << " | "
+           << pct("circle", "final") << " / " << rmse("circle", "final") << " |\n";
+      }
+      md << "\n";
+    }
     const std::vector<std::pair<std::string, std::string>> series = {
         {"circle_coverage", "circle coverage"}, {"cylinder_coverage", "cylinder coverage"},
         {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
