@@ -2,13 +2,16 @@
 // `sonomap run`'s EDF comparison (edf.* keys, edf.csv, the edf_* columns, summary entries):
 // on the smoke room the field's bearings slip far off the rays, while its sphere-traced ranges
 // meet the true surfaces; the truth is an exact ray cast against the scene's own triangles.
+#include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include "harness/errors.hpp"
+#include "harness/report.hpp"
 #include "harness/run.hpp"
 #include "harness/scenario_yaml.hpp"
 #include "sim/world_geometry.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -118,7 +121,8 @@ double distance_to(const Eigen::Vector3d& p, const sonomap::sim::WorldTriangle& 
 TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges meet the surfaces",
           "[run][edf]") {
   ScratchDir scratch("run-edf");
-  auto o = smoke(scratch.path() / "out", "vdb_gpdf", 30);
+  fs::create_directory(scratch.path() / "runs");  // laid out as `compare` does, for the report
+  auto o = smoke(scratch.path() / "runs" / "smoke-gpdf", "vdb_gpdf", 30);
   o.every = 10;                // frames 0, 10, 20 and 29
   o.picture_frames = {29};     // the arrows picture of the last frame
   sonomap::harness::run_scenario(o);
@@ -186,6 +190,18 @@ TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges 
   CHECK(slips_known == slip["observed"].get<int>());
   CHECK(hits > 60);
   CHECK(along_ray >= hits * 4 / 5);  // measured 2026-11-22: 89 of 95
+
+  // The roll-up carries the slip and report.md's "Compare to EDF" table lists the run.
+  sonomap::harness::build_report(scratch.path(), true);
+  const auto rollup = read_csv(scratch.path() / "rollup.csv");
+  REQUIRE(rollup.size() == 1);
+  CHECK(std::stod(rollup[0].at("edf_slip_final_median_deg")) ==
+        Approx(slip["median_deg"].get<double>()).margin(0.005));
+  CHECK(!rollup[0].at("edf_circle_final_coverage").empty());
+  const std::string report = sonomap::test::text_of(scratch.path() / "report.md");
+  CHECK(report.find("### Compare to EDF") != std::string::npos);
+  CHECK(report.find("| smoke-gpdf | vdb_gpdf | " +
+                    fmt::format("{:.2f}", slip["median_deg"].get<double>())) != std::string::npos);
 }
 
 TEST_CASE("EDF with a depth-only mapper: no field, so everything EDF is unknown", "[run][edf]") {
