@@ -31,7 +31,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -165,6 +164,8 @@ struct CellResult {
   std::map<std::string, std::vector<double>> samples;
   std::vector<double> frame_cpu_ms;  // process CPU time of the whole frame (all threads)
   size_t peak_map_bytes = 0;
+  double frame_ratio = NAN;  // median frame / Open3D's median frame in the same cell
+  double map_ratio = NAN;    // the same for the fusion alone
 
   double median_of(const std::string& stage) const { return median(samples.at(stage)); }
 };
@@ -176,6 +177,8 @@ struct ReferenceCheck {
   size_t open3d_vertices = 0;
   size_t tsdf_samples = 0;
   double median_distance = NAN;  // m, Open3D vertex to the nearest TSDF sample
+  // A reference that is not where our TSDF is (wrong pose or axes) makes every ratio void.
+  bool passed() const { return open3d_vertices > 0 && median_distance < voxel; }
 };
 
 double median_nearest_distance(const std::vector<Eigen::Vector3d>& from,
@@ -192,6 +195,9 @@ double median_nearest_distance(const std::vector<Eigen::Vector3d>& from,
     if (tree.SearchKNN(p, 1, index, distance2) == 1) distances.push_back(std::sqrt(distance2[0]));
   return distances.empty() ? NAN : median(std::move(distances));
 }
+
+// The OpenMP runtime reads OMP_WAIT_POLICY once, when it loads: record what it was.
+const char* omp_wait_policy() { return std::getenv("OMP_WAIT_POLICY"); }
 
 double process_peak_rss_mb() {
   rusage usage{};
@@ -303,6 +309,48 @@ std::string stage_summary(const CellResult& cell) {
   return text;
 }
 
+void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const std::vector<Frame>& frames,
+                const std::vector<CellResult>& results, const std::vector<ReferenceCheck>& checks,
+                double rss_peak_mb, double rss_frames_mb) {
+  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  json out{{"scenario", {{"name", scenario.name}, {"file", o.scenario}}},
+           {"code_version", code_version()},
+           {"frames", json::array()},
+           {"every", o.every},
+           {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
+           {"open3d", {{"class", "ScalableTSDFVolume"},
+                       {"sdf_trunc_voxels", kOpen3dTruncationVoxels},
+                       {"depth_trunc_m", scenario.camera.max_range},
+                       {"omp_wait_policy",
+                        omp_wait_policy() ? omp_wait_policy() : "unset (libgomp: spin, then sleep)"},
+                       {"timed", "depth image copy + RGBDImage::CreateFromColorAndDepth + Integrate"}}},
+           {"results", json::array()},
+           {"open3d_checks", json::array()},
+           {"peak_rss_mb", rss_peak_mb},
+           {"rss_after_rendering_mb", rss_frames_mb}};
+  for (const Frame& f : frames) out["frames"].push_back(f.index);
+  for (const CellResult& c : results) {
+    json stages = json::object();
+    for (const std::string& name : c.stage_order) stages[name] = c.median_of(name);
+    out["results"].push_back({{"voxel", c.voxel},
+                              {"threads", c.threads},
+                              {"mapper", c.mapper},
+                              {"frames", c.samples.at("frame").size()},
+                              {"median_ms", stages},
+                              {"frame_cpu_median_ms", median(c.frame_cpu_ms)},
+                              {"frame_ratio_to_open3d", number(c.frame_ratio)},
+                              {"map_ratio_to_open3d", number(c.map_ratio)},
+                              {"peak_map_bytes", c.peak_map_bytes}});
+  }
+  for (const ReferenceCheck& c : checks)
+    out["open3d_checks"].push_back({{"voxel", c.voxel},
+                                    {"threads", c.threads},
+                                    {"open3d_vertices", c.open3d_vertices},
+                                    {"tsdf_samples", c.tsdf_samples},
+                                    {"median_distance_m", number(c.median_distance)}});
+  write_text_file(o.json, out.dump(2) + "\n");
+}
+
 void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   check_options(o);
   const sim::Scenario scenario = load_scenario(o.scenario);
@@ -334,80 +382,49 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   const double rss_peak_mb = process_peak_rss_mb();
 
   // The reference of a cell: Open3D at the same voxel size and thread count.
-  const auto reference = [&](const CellResult& cell) -> const CellResult* {
-    for (const CellResult& r : results)
-      if (r.mapper == kOpen3d && r.voxel == cell.voxel && r.threads == cell.threads) return &r;
-    return nullptr;
-  };
-  const auto ratio = [&](const CellResult& cell, const char* stage) {
-    const CellResult* ref = reference(cell);
-    return ref ? cell.median_of(stage) / ref->median_of(stage) : NAN;
-  };
+  for (CellResult& cell : results)
+    for (const CellResult& ref : results)
+      if (ref.mapper == kOpen3d && ref.voxel == cell.voxel && ref.threads == cell.threads) {
+        cell.frame_ratio = cell.median_of("frame") / ref.median_of("frame");
+        cell.map_ratio = cell.median_of("map") / ref.median_of("map");
+      }
 
-  std::printf("bench map: '%s', %dx%d, %zu frames (every %d-th from 0), medians per frame in ms\n",
-              scenario.name.c_str(), scenario.camera.width, scenario.camera.height, frames.size(),
-              o.every);
-  std::printf("map = the mapper's integrate (open3d: depth copy + RGBDImage + Integrate, truncation "
-              "%.0f voxels); raster = circle + cylinder\nfrom the map's surface samples (as `run`); "
-              "frame = map + raster; cpu = process CPU time of the frame (all threads).\n"
-              "x o3d = median ratio to open3d in the same (voxel, threads) cell.\n",
-              kOpen3dTruncationVoxels);
-  std::printf("%6s %3s %-10s %6s | %9s %9s %9s %9s | %9s %9s | %9s | %s\n", "voxel", "thr", "mapper",
-              "frames", "frame", "cpu", "map", "raster", "frame/o3d", "map/o3d", "peak MB", "stages");
-  for (const CellResult& c : results) {
-    const bool has_raster = c.samples.count("raster") > 0;
-    std::printf("%6.2f %3d %-10s %6zu | %9.2f %9.2f %9.2f %9s | %9s %9s | %9.1f | %s\n", c.voxel,
-                c.threads, c.mapper.c_str(), c.samples.at("frame").size(), c.median_of("frame"),
-                median(c.frame_cpu_ms), c.median_of("map"),
-                has_raster ? fmt::format("{:.2f}", c.median_of("raster")).c_str() : "-",
-                fmt::format("{:.2f}", ratio(c, "frame")).c_str(),
-                fmt::format("{:.2f}", ratio(c, "map")).c_str(), c.peak_map_bytes / 1048576.0,
-                stage_summary(c).c_str());
-  }
+  fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), medians per frame in ms\n",
+             scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every);
+  fmt::print("map = the mapper's integrate (open3d: depth copy + RGBDImage + Integrate, truncation "
+             "{:g} voxels); raster = circle + cylinder\nfrom the map's surface samples (as `run`); "
+             "frame = map + raster; cpu = process CPU time of the frame (all threads);\n"
+             "frame/o3d, map/o3d = ratios of the medians to open3d's in the same (voxel, threads) "
+             "cell.\n",
+             kOpen3dTruncationVoxels);
+  const auto ms = [](double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : std::string("-"); };
+  fmt::print("{:>6} {:>3} {:<10} {:>6} | {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9} | {}\n", "voxel",
+             "thr", "mapper", "frames", "frame", "cpu", "map", "raster", "frame/o3d", "map/o3d",
+             "peak MB", "stages");
+  for (const CellResult& c : results)
+    fmt::print("{:>6.2f} {:>3} {:<10} {:>6} | {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9.1f} | {}\n",
+               c.voxel, c.threads, c.mapper, c.samples.at("frame").size(), ms(c.median_of("frame")),
+               ms(median(c.frame_cpu_ms)), ms(c.median_of("map")),
+               ms(c.samples.count("raster") ? c.median_of("raster") : NAN), ms(c.frame_ratio),
+               ms(c.map_ratio), c.peak_map_bytes / 1048576.0, stage_summary(c));
   for (const ReferenceCheck& c : checks)
-    std::printf("open3d check, voxel %.2f, %d threads: %zu mesh vertices, median distance to the "
-                "TSDF's %zu surface samples %.4f m (%.2f voxels)\n",
-                c.voxel, c.threads, c.open3d_vertices, c.tsdf_samples, c.median_distance,
-                c.median_distance / c.voxel);
-  std::printf("peak RSS: %.1f MB for the whole run (%.1f MB after rendering the frames)\n",
-              rss_peak_mb, rss_frames_mb);
+    fmt::print("open3d check, voxel {:.2f}, {} threads: {} mesh vertices, median distance to the "
+               "TSDF's {} surface samples {:.4f} m ({:.2f} voxels): {}\n",
+               c.voxel, c.threads, c.open3d_vertices, c.tsdf_samples, c.median_distance,
+               c.median_distance / c.voxel, c.passed() ? "ok" : "FAILED");
+  fmt::print("peak RSS: {:.1f} MB for the whole run ({:.1f} MB after rendering the frames)\n",
+             rss_peak_mb, rss_frames_mb);
+  if (!omp_wait_policy() && std::any_of(o.threads.begin(), o.threads.end(), [](int t) { return t > 1; }))
+    fmt::print("note: OMP_WAIT_POLICY is unset, so Open3D's OpenMP threads spin before they "
+               "sleep: on a busy machine\nits multi-thread times are mostly spinning "
+               "(OMP_WAIT_POLICY=PASSIVE measures a shared machine).\n");
 
-  if (o.json.empty()) return;
-  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  json out{{"scenario", {{"name", scenario.name}, {"file", o.scenario}}},
-           {"code_version", code_version()},
-           {"frames", json::array()},
-           {"every", o.every},
-           {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
-           {"open3d", {{"class", "ScalableTSDFVolume"},
-                       {"sdf_trunc_voxels", kOpen3dTruncationVoxels},
-                       {"depth_trunc_m", scenario.camera.max_range},
-                       {"timed", "depth image copy + RGBDImage::CreateFromColorAndDepth + Integrate"}}},
-           {"results", json::array()},
-           {"open3d_checks", json::array()},
-           {"peak_rss_mb", rss_peak_mb},
-           {"rss_after_rendering_mb", rss_frames_mb}};
-  for (const Frame& f : frames) out["frames"].push_back(f.index);
-  for (const CellResult& c : results) {
-    json stages = json::object();
-    for (const std::string& name : c.stage_order) stages[name] = c.median_of(name);
-    out["results"].push_back({{"voxel", c.voxel},
-                              {"threads", c.threads},
-                              {"mapper", c.mapper},
-                              {"frames", c.samples.at("frame").size()},
-                              {"median_ms", stages},
-                              {"frame_cpu_median_ms", median(c.frame_cpu_ms)},
-                              {"frame_ratio_to_open3d", number(ratio(c, "frame"))},
-                              {"map_ratio_to_open3d", number(ratio(c, "map"))},
-                              {"peak_map_bytes", c.peak_map_bytes}});
-  }
-  for (const ReferenceCheck& c : checks)
-    out["open3d_checks"].push_back({{"voxel", c.voxel},
-                                    {"threads", c.threads},
-                                    {"open3d_vertices", c.open3d_vertices},
-                                    {"tsdf_samples", c.tsdf_samples},
-                                    {"median_distance_m", number(c.median_distance)}});
-  write_text_file(o.json, out.dump(2) + "\n");
+  const bool reference_ok =
+      std::all_of(checks.begin(), checks.end(), [](const ReferenceCheck& c) { return c.passed(); });
+  if (!o.json.empty()) write_json(o, scenario, frames, results, checks, rss_peak_mb, rss_frames_mb);
+  if (!reference_ok)
+    throw std::runtime_error("bench map: the Open3D reference failed its check (its surface is not "
+                             "within a voxel of our TSDF's): the ratios are not valid");
 }
 
 }  // namespace
