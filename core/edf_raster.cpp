@@ -16,6 +16,9 @@ void EdfRasterConfig::validate() const {
   positive(sample_radius, "sample_radius");
   positive(hit_tolerance, "hit_tolerance");
   positive(max_range, "max_range");
+  for (double h : trace_heights)
+    if (!std::isfinite(h))
+      throw std::invalid_argument("edf config: trace_heights must be finite, got " + std::to_string(h));
   if (max_steps < 1)
     throw std::invalid_argument("edf config: max_steps must be >= 1, got " +
                                 std::to_string(max_steps));
@@ -35,6 +38,18 @@ namespace {
 
 double degrees_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// Which end describes a bin whose rays ended differently: a hit wins, then the ends that say
+// most about the field (it went on too long, or it ran out of map), then "nothing in range".
+int precedence(TraceEnd end) {
+  switch (end) {
+    case TraceEnd::Hit: return 3;
+    case TraceEnd::StepLimit: return 2;
+    case TraceEnd::Unobserved: return 1;
+    case TraceEnd::OutOfRange: return 0;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -80,44 +95,60 @@ EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimu
     bin.slip_deg = static_cast<float>(degrees_between(toward, rays[k]));
   }
 
-  // (b) Sphere tracing: every ray steps by the field's distance, all active rays in one query.
-  std::vector<double> t(n, 0.0);
-  std::vector<size_t> active(n);
-  for (size_t k = 0; k < n; ++k) active[k] = k;
+  // (b) Sphere tracing: every ray steps by the field's distance, all active rays (bin x
+  // height) in one query per step. Ray r belongs to bin r % n.
+  std::vector<Eigen::Vector3d> starts;
+  if (config.trace_heights.empty()) starts.push_back(origin.position);
+  for (double h : config.trace_heights)
+    starts.emplace_back(origin.position.x(), origin.position.y(), origin.ground_z + h);
+  const size_t ray_count = n * starts.size();
+  std::vector<double> t(ray_count, 0.0);
+  std::vector<TraceEnd> ends(ray_count, TraceEnd::StepLimit);
+  std::vector<int> steps(ray_count, 0);
+  std::vector<size_t> active(ray_count);
+  for (size_t r = 0; r < ray_count; ++r) active[r] = r;
   for (int step = 0; step < config.max_steps && !active.empty(); ++step) {
     points.resize(active.size());
-    for (size_t i = 0; i < active.size(); ++i)
-      points[i] = (origin.position + t[active[i]] * rays[active[i]]).cast<float>();
+    for (size_t i = 0; i < active.size(); ++i) {
+      const size_t r = active[i];
+      points[i] = (starts[r / n] + t[r] * rays[r % n]).cast<float>();
+    }
     mapper.query(points, answers);
     std::vector<size_t> still;
     for (size_t i = 0; i < active.size(); ++i) {
-      const size_t k = active[i];
+      const size_t r = active[i];
       const DistanceQuery& q = answers[i];
-      EdfBin& bin = out.bins[k];
-      bin.steps = step + 1;
+      steps[r] = step + 1;
       if (!q.observed || !std::isfinite(q.distance) || q.distance < 0.0f) {
-        bin.end = TraceEnd::Unobserved;
+        ends[r] = TraceEnd::Unobserved;
         continue;
       }
       // The surface is at least the field's distance further on; on a plane hit at any angle
       // t + d is still short of the true hit (t + d / cos), so adding it only removes bias.
-      const double reach = t[k] + q.distance;
+      const double reach = t[r] + q.distance;
       if (reach > config.max_range) {
-        bin.end = TraceEnd::OutOfRange;
+        ends[r] = TraceEnd::OutOfRange;
         continue;
       }
+      t[r] = reach;
       if (q.distance < config.hit_tolerance) {
-        bin.end = TraceEnd::Hit;
-        RasterCell& cell = out.traced.bins[k];
-        cell.range = static_cast<float>(reach);
-        cell.point = (origin.position + reach * rays[k]).cast<float>();
+        ends[r] = TraceEnd::Hit;
         continue;
       }
-      t[k] = reach;
-      bin.end = TraceEnd::StepLimit;  // until a later step ends it otherwise
-      still.push_back(k);
+      still.push_back(r);
     }
     active.swap(still);
+  }
+  for (size_t r = 0; r < ray_count; ++r) {
+    const size_t k = r % n;
+    EdfBin& bin = out.bins[k];
+    RasterCell& cell = out.traced.bins[k];
+    bin.steps = std::max(bin.steps, steps[r]);
+    if (r < n || precedence(ends[r]) > precedence(bin.end)) bin.end = ends[r];
+    if (ends[r] == TraceEnd::Hit && t[r] < cell.range) {
+      cell.range = static_cast<float>(t[r]);
+      cell.point = (starts[r / n] + t[r] * rays[k]).cast<float>();
+    }
   }
   return out;
 }

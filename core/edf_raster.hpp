@@ -8,7 +8,9 @@
 //      so the slip is large wherever that is not the one straight along the ray (the paper's
 //      Fig. "arrow_esdf": such bearings do not run round the listener in order);
 //  (b) the range along the bin's ray found by sphere tracing the field, a circle built from
-//      the EDF alone, to compare with the map's circle against the same ground truth.
+//      the EDF alone, to compare with the map's circle against the same ground truth. The
+//      circle holds obstacles anywhere in a height band, so rays can be traced at several
+//      heights (trace_heights) and the bin keeps the nearest hit.
 // Where the field is unobserved the values are unknown (NaN / kUnknownRange), never guessed.
 #pragma once
 
@@ -27,8 +29,11 @@ struct EdfRasterConfig {
   double hit_tolerance = 0.05;  // m: a traced ray has hit when the field reads below this
   int max_steps = 64;           // sphere-tracing iterations before a ray gives up (unknown)
   double max_range = 5.0;       // m: a ray that gets this far without a hit is unknown
+  // Heights above the ground (origin.ground_z) of the horizontal rays traced per bin; empty:
+  // one ray at the sensor's height. The sample circle is always at the sensor's height.
+  std::vector<double> trace_heights;
   // Throws std::invalid_argument naming the field unless every value is finite and positive
-  // and max_steps >= 1.
+  // (trace heights: finite) and max_steps >= 1.
   void validate() const;
 };
 
@@ -50,9 +55,11 @@ struct EdfBin {
   float slip_deg = NAN;         // in [0, 180]
   Eigen::Vector3f sample_point = Eigen::Vector3f::Constant(NAN);       // world
   Eigen::Vector3f closest_direction = Eigen::Vector3f::Constant(NAN);  // unit, -gradient, world
-  // (b) Sphere tracing along the ray; the range (and hit point) lives in EdfRaster::traced.
+  // (b) Sphere tracing; the range (and hit point) lives in EdfRaster::traced. With several
+  // trace heights: Hit if any ray hit, else StepLimit, Unobserved, OutOfRange in that order
+  // (the first that any of its rays met).
   TraceEnd end = TraceEnd::Unobserved;
-  int steps = 0;  // field queries spent on this ray
+  int steps = 0;  // the most field queries any of the bin's rays spent
 };
 
 struct EdfRaster {
@@ -62,7 +69,7 @@ struct EdfRaster {
 
 // The EDF variant of the circle around `origin` (its position is the sensor: the plane of the
 // circle is at origin.position.z). One Mapper::query call for all sample points, then one per
-// sphere-tracing iteration for all still-active rays, so the result does not depend on how
+// sphere-tracing iteration for all still-active rays (every bin and height), so the result does not depend on how
 // the mapper parallelises its queries. Throws std::invalid_argument on an invalid config,
 // azimuth_bins outside [1, 36000] or a non-finite origin.
 EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimuth_bins,

@@ -21,14 +21,16 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Vertical walls {x : n.x = offset} seen from the side n points to (n horizontal, unit). The
-// field is the exact unsigned distance to the nearest wall, its gradient that wall's normal
-// (away from the surface). `observed` limits where the "map" knows anything.
+// Vertical walls {x : n.x = offset, x.z <= top} (n horizontal, unit; infinitely wide and deep).
+// The field is the exact unsigned distance to the nearest wall, sqrt(d^2 + above^2) with d the
+// distance to the wall's plane and above the height over its top edge; its gradient points
+// from the wall's closest point to x. `observed` limits where the "map" knows anything.
 class PlaneField final : public Mapper {
  public:
   struct Wall {
     Eigen::Vector3d normal;
     double offset;
+    double top = std::numeric_limits<double>::infinity();
   };
   std::vector<Wall> walls;
   std::function<bool(const Eigen::Vector3d&)> observed = [](const Eigen::Vector3d&) { return true; };
@@ -48,9 +50,12 @@ class PlaneField final : public Mapper {
       double best = std::numeric_limits<double>::infinity();
       for (const Wall& w : walls) {
         const double d = w.normal.dot(p) - w.offset;
-        if (std::abs(d) < best) {
-          best = std::abs(d);
-          out[i].gradient = (d >= 0 ? w.normal : Eigen::Vector3d(-w.normal)).cast<float>();
+        const double above = std::max(0.0, p.z() - w.top);
+        const double dist = std::hypot(d, above);
+        if (dist < best) {
+          best = dist;
+          const Eigen::Vector3d away = d * w.normal + above * Eigen::Vector3d::UnitZ();
+          out[i].gradient = (dist > 0 ? Eigen::Vector3d(away / dist) : w.normal).cast<float>();
         }
       }
       out[i].observed = true;
@@ -158,6 +163,39 @@ TEST_CASE("EDF: at the centre of a square room slip is 0 at the wall normals and
   CHECK(s.p90_deg == Approx(40.0).margin(1e-3));
 }
 
+TEST_CASE("EDF: a knee-high wall under the sensor's ray is found by a ray traced at knee height",
+          "[edf_raster]") {
+  // A wall 0.5 m high 1 m ahead, a full wall 2 m ahead; the sensor at 1.5 m.
+  PlaneField field = wall_ahead();
+  field.walls.push_back({-Eigen::Vector3d::UnitX(), -1.0, 0.5});
+  const RasterOrigin eye{Eigen::Vector3d(0.0, 0.0, 1.5), -0.5 * kDeg, 0.0};
+  EdfRasterConfig config;
+  // At the sensor's height the ray passes 1 m over the low wall and meets the full one.
+  const EdfRaster high = edf_raster(field, eye, 360, config);
+  REQUIRE(high.traced.bins[0].known());
+  CHECK(std::abs(high.traced.bins[0].range - 2.0) <= config.hit_tolerance);
+  // Rays at 0.25 m and 1.5 m: the bin keeps the nearest hit, the low wall at 1 m.
+  config.trace_heights = {0.25, 1.5};
+  const EdfRaster both = edf_raster(field, eye, 360, config);
+  REQUIRE(both.traced.bins[0].known());
+  CHECK(std::abs(both.traced.bins[0].range - 1.0) <= config.hit_tolerance);
+  CHECK(both.traced.bins[0].point.z() == Approx(0.25));
+  CHECK(both.bins[0].end == TraceEnd::Hit);
+  // 60 degrees off: the low wall at 1 / cos 60 = 2 m.
+  REQUIRE(both.traced.bins[60].known());
+  CHECK(std::abs(both.traced.bins[60].range - 2.0) <= config.hit_tolerance);
+  // Bins facing away hit nothing at either height.
+  CHECK_FALSE(both.traced.bins[180].known());
+  CHECK(both.bins[180].end == TraceEnd::OutOfRange);
+  // The slip is read on the sample circle at the sensor's height: with a radius of 0.8 m, from
+  // (0.8, 0, 1.5) the closest surface is the low wall's top edge, 0.2 m ahead and 1 m down
+  // (1.02 m; the full wall is 1.2 m away): atan2(1, 0.2) = 78.7 degrees off the ray.
+  config.sample_radius = 0.8;
+  const EdfRaster sampled = edf_raster(field, eye, 360, config);
+  CHECK(sampled.bins[0].sample_distance == Approx(std::hypot(0.2, 1.0)).margin(1e-5));
+  CHECK(sampled.bins[0].slip_deg == Approx(std::atan2(1.0, 0.2) / kDeg).margin(1e-3));
+}
+
 TEST_CASE("EDF: the field is queried once for the circle and once per tracing step, for all bins",
           "[edf_raster]") {
   const PlaneField field = square_room();
@@ -246,6 +284,9 @@ TEST_CASE("EDF: bad configuration or origin is rejected", "[edf_raster][bad_inpu
   CHECK_THROWS_AS(edf_raster(field, o, 360, c), std::invalid_argument);
   c = {};
   c.max_range = -1.0;
+  CHECK_THROWS_AS(edf_raster(field, o, 360, c), std::invalid_argument);
+  c = {};
+  c.trace_heights = {0.5, NAN};
   CHECK_THROWS_AS(edf_raster(field, o, 360, c), std::invalid_argument);
   c = {};
   c.max_steps = 0;

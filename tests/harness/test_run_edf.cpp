@@ -123,22 +123,27 @@ TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges 
   ScratchDir scratch("run-edf");
   fs::create_directory(scratch.path() / "runs");  // laid out as `compare` does, for the report
   auto o = smoke(scratch.path() / "runs" / "smoke-gpdf", "vdb_gpdf", 30);
+  // Without the sliding crate: it passes under the camera's view, so the truth has it where
+  // the map (and any field built from it) cannot, which says nothing about the EDF.
+  o.overrides.push_back("moving.crate.appear=100");
   o.every = 10;                // frames 0, 10, 20 and 29
   o.picture_frames = {29};     // the arrows picture of the last frame
   sonomap::harness::run_scenario(o);
   const fs::path dir = o.out;
   CHECK(fs::is_regular_file(dir / "pictures" / "frame_000029_edf.png"));
 
+  // By default the EDF runs on every 5th evaluated frame and the last: frames 0 and 29.
   const auto frames = read_csv(dir / "frames.csv");
   REQUIRE(frames.size() == 4);
   for (const auto& f : frames) {
+    const bool edf_frame = f.at("frame") == "0" || f.at("frame") == "29";
     INFO("frame " << f.at("frame"));
-    CHECK(!f.at("edf_known").empty());
-    CHECK(!f.at("edf_coverage").empty());
+    CHECK(f.at("edf_known").empty() != edf_frame);
+    CHECK(f.at("edf_coverage").empty() != edf_frame);
   }
   const json summary = summary_of(dir);
   REQUIRE(summary.contains("edf"));
-  CHECK(summary["edf"]["frames"] == 4);
+  CHECK(summary["edf"]["frames"] == 2);
   const json& slip = summary["edf"]["slip"]["final"];
   REQUIRE(slip["median_deg"].is_number());
   // Several surfaces round the listener: the closest one is rarely the one along the ray, so
@@ -150,14 +155,17 @@ TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges 
 
   // The final frame per bin, against the scene's true triangles (exact poses: no localisation
   // noise). Sphere tracing stops within the hit tolerance of a surface, so every hit point is
-  // that close to a true surface (plus the map's error, a voxel); where the ray does not just
-  // graze an object on its way, that is where the bin's ray at the sensor's height meets it.
+  // that close to a true surface (plus the map's error, a voxel); where the rays do not just
+  // graze an object on their way, that is the nearest place where the bin's horizontal rays at
+  // the trace heights (edf.trace_rows slices of the band) meet the scene.
   const auto bins = read_csv(dir / "edf.csv");
   REQUIRE(bins.size() == 360);
   const auto& last = frames.back();
   const Eigen::Vector3d eye(std::stod(last.at("x")), std::stod(last.at("y")), std::stod(last.at("z")));
+  const auto heights = summary["config"]["edf"]["trace_heights"].get<std::vector<double>>();
+  REQUIRE(heights.size() == 4);  // the default edf.trace_rows
   const double heading = std::stod(last.at("heading_deg")) * M_PI / 180.0;
-  const auto scenario = sonomap::harness::load_scenario(o.scenario, small_camera());
+  const auto scenario = sonomap::harness::load_scenario(o.scenario, o.overrides);
   const auto triangles = sonomap::sim::world_triangles(scenario, std::stod(last.at("time")));
   const double voxel = 0.05;  // VDB-GPDF's default global voxel
   const double hit_tolerance = summary["config"]["edf"]["hit_tolerance"].get<double>();
@@ -177,19 +185,31 @@ TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges 
     ++hits;
     const double a = heading + (k + 0.5) * M_PI / 180.0;
     const Eigen::Vector3d ray(std::cos(a), std::sin(a), 0.0);
-    double exact = std::numeric_limits<double>::infinity();
-    for (const auto& tri : triangles) exact = std::min(exact, ray_hit(eye, ray, tri));
+    double exact = std::numeric_limits<double>::infinity(), exact_height = NAN;
+    for (double h : heights) {
+      const Eigen::Vector3d start(eye.x(), eye.y(), scenario.ground_z + h);
+      for (const auto& tri : triangles) {
+        const double hit = ray_hit(start, ray, tri);
+        if (hit < exact) exact = hit, exact_height = h;
+      }
+    }
     const double traced = std::stod(b.at("traced_range"));
+    const double traced_height = std::stod(b.at("traced_height"));
+    CHECK(std::any_of(heights.begin(), heights.end(), [&](double h) { return std::abs(h - traced_height) < 1e-4; }));
+    const Eigen::Vector3d hit_point =
+        Eigen::Vector3d(eye.x(), eye.y(), scenario.ground_z + traced_height) + traced * ray;
     double off_surface = std::numeric_limits<double>::infinity();
-    for (const auto& tri : triangles) off_surface = std::min(off_surface, distance_to(eye + traced * ray, tri));
-    INFO("bin " << k << ": traced " << traced << " m, exact ray hit " << exact
-                << " m, hit point " << off_surface << " m off the nearest surface");
+    for (const auto& tri : triangles) off_surface = std::min(off_surface, distance_to(hit_point, tri));
+    INFO("bin " << k << ": traced " << traced << " m, exact ray hit " << exact << " m at height "
+                << exact_height << " m, hit point " << off_surface << " m off the nearest surface");
     CHECK(off_surface <= hit_tolerance + voxel);
     if (std::abs(traced - exact) <= voxel) ++along_ray;
   }
   CHECK(slips_known == slip["observed"].get<int>());
   CHECK(hits > 60);
-  CHECK(along_ray >= hits * 4 / 5);  // measured 2026-11-22: 89 of 95
+  // The rest graze an object on the way (a hit within the tolerance of a surface the exact ray
+  // just misses). Measured 2026-11-22: 90 of 97.
+  CHECK(along_ray >= hits * 4 / 5);
 
   // The roll-up carries the slip and report.md's "Compare to EDF" table lists the run.
   sonomap::harness::build_report(scratch.path(), true);
