@@ -55,13 +55,14 @@ GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance) co
   if (n == 0) return out;
   const bool se = params_.kernel == GpKernel::RevertingSE;
   // Exponents of the kernel terms; every term is scaled by exp(-max exponent).
+  // radius[i] holds the squared radius for the SE kernel (it needs no square root).
   thread_local std::vector<double> expo, radius;
   expo.resize(n);
   radius.resize(n);
   double max_expo = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i) {
     const double r2 = (x - points_[i].cast<double>()).squaredNorm();
-    radius[i] = std::sqrt(r2);
+    radius[i] = se ? r2 : std::sqrt(r2);
     expo[i] = se ? -0.5 * a_ * r2 : -a_ * radius[i];
     max_expo = std::max(max_expo, expo[i]);
   }
@@ -87,7 +88,7 @@ GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance) co
     size_t nearest = 0;
     for (size_t i = 1; i < n; ++i)
       if (radius[i] < radius[nearest]) nearest = i;
-    out.distance = radius[nearest];
+    out.distance = se ? std::sqrt(radius[nearest]) : radius[nearest];
     if (out.distance > 0.0) out.gradient = (x - points_[nearest].cast<double>()) / out.distance;
     out.variance = params_.variance_cap;
     out.valid = true;

@@ -86,6 +86,7 @@ struct LocalGps {
 };
 
 // Per local voxel: the sum of the frame's points in it (x, y, z) and their count (w).
+constexpr int kNormalReach = 2;  // local voxels around p that the PCA normal sees
 using PointSumGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
 
 Eigen::Vector3d centroid(const openvdb::Vec4f& sum) {
@@ -103,9 +104,9 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
   int count = 0;
-  for (int dx = -2; dx <= 2; ++dx)
-    for (int dy = -2; dy <= 2; ++dy)
-      for (int dz = -2; dz <= 2; ++dz) {
+  for (int dx = -kNormalReach; dx <= kNormalReach; ++dx)
+    for (int dy = -kNormalReach; dy <= kNormalReach; ++dy)
+      for (int dz = -kNormalReach; dz <= kNormalReach; ++dz) {
         openvdb::Vec4f cell;
         if (!local.probeValue(c.offsetBy(dx, dy, dz), cell)) continue;
         const Eigen::Vector3d d = centroid(cell) - p;  // relative to p: well conditioned
@@ -115,11 +116,49 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
       }
   if (count < 5) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d mean = sum / count;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(outer / count - mean * mean.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(outer / count - mean * mean.transpose());
   Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
   if (eig.info() != Eigen::Success || !n.allFinite()) return Eigen::Vector3d::Zero();
   n.normalize();
   return n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n;
+}
+
+// Rays converge on the sensor, so near it thousands of them cross the same voxel: each crossed
+// voxel is queried once, at its centre, and fused with one unit of weight per ray that crossed
+// it (what one carving point per ray and voxel would give, at a fraction of the GP queries:
+// measured 5x fewer on the room).
+std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
+                                         const std::vector<std::vector<openvdb::Coord>>& carved,
+                                         const LocalGps& locals) {
+  openvdb::Int32Grid counts(0);
+  {
+    auto acc = counts.getAccessor();
+    for (const auto& leaf_voxels : carved)
+      for (const auto& v : leaf_voxels) acc.setValue(v, acc.getValue(v) + 1);
+  }
+  std::vector<std::pair<openvdb::Coord, int>> voxels;
+  voxels.reserve(counts.activeVoxelCount());
+  for (auto v = counts.cbeginValueOn(); v; ++v) voxels.emplace_back(v.getCoord(), *v);
+  std::vector<QueryUpdate> out(voxels.size());
+  std::vector<char> valid(voxels.size(), 0);
+  const double vg = config.global_voxel;
+  parallel_for_each_index(voxels.size(), [&](size_t i) {
+    const Eigen::Vector3d q = voxel_centre(voxels[i].first, vg);
+    const int gp = locals.nearest(q);
+    if (gp < 0) return;
+    const GpPrediction pred = locals.gps[gp].predict(q, config.inverse_variance_fusion);
+    if (!pred.valid) return;
+    const double rays = voxels[i].second;
+    const double weight = config.inverse_variance_fusion ? rays / pred.variance : rays;
+    out[i] = {voxels[i].first, static_cast<float>(-pred.distance), static_cast<float>(weight)};
+    valid[i] = 1;
+  });
+  size_t kept = 0;
+  for (size_t i = 0; i < out.size(); ++i)
+    if (valid[i]) out[kept++] = out[i];
+  out.resize(kept);
+  return out;
 }
 
 }  // namespace
@@ -238,6 +277,7 @@ void VdbGpdf::integrate(const Frame& frame) {
   // a voxel (measured: 0.8 voxel worst case on a sphere).
   t0 = Clock::now();
   std::vector<std::vector<QueryUpdate>> updates(training.size());
+  std::vector<std::vector<openvdb::Coord>> carved(training.size());  // voxels each leaf's rays cross
   parallel_for_each_index(training.size(), [&](size_t leaf) {
     auto observed = grid_->getConstAccessor();
     auto local_acc = local.getConstAccessor();
@@ -292,9 +332,9 @@ void VdbGpdf::integrate(const Frame& frame) {
       for (int j = 1; j <= config_.trunc_front; ++j)
         fuse_query(p + j * config_.query_step * u, -1.0);
       if (!config_.free_space_carving) continue;
-      // One carving point per global voxel the ray crosses (DDA, mid-segment), from one
-      // carving step in front of p to the sensor: fixed steps along fixed rays (a static
-      // camera) can skip a voxel forever, and then a moved object is never carved there.
+      // Every observed global voxel the ray crosses (DDA) from one carving step in front of p
+      // to the sensor: fixed steps along fixed rays (a static camera) can skip a voxel
+      // forever, and then a moved object is never carved there.
       using Ray = openvdb::math::Ray<double>;
       const double start = config_.carving_step;
       if (range <= start) continue;
@@ -303,12 +343,12 @@ void VdbGpdf::integrate(const Frame& frame) {
                     0.0, (range - start) / vg);
       openvdb::math::DDA<Ray, 0> dda(ray);
       do {
-        const double mid = 0.5 * (dda.time() + std::min(dda.next(), ray.t1()));
-        const Eigen::Vector3d q = p + (start + mid * vg) * u;
-        if (observed.getValue(voxel_of(q, vg))[1] > 0.0f) fuse_query(q, -1.0);
+        const openvdb::Coord v = dda.voxel();
+        if (observed.getValue(v)[1] > 0.0f) carved[leaf].push_back(v);
       } while (dda.step());
     }
   });
+  updates.push_back(carving_updates(config_, carved, locals));
   times_.stages.emplace_back("query_points", ms_since(t0));
 
   // 4. Fusion: sum the frame's updates per voxel (in a fixed order), then blend each touched
