@@ -60,8 +60,16 @@ EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimu
   if (azimuth_bins < 1 || azimuth_bins > 36000)
     throw std::invalid_argument("edf raster: azimuth_bins must be in [1, 36000], got " +
                                 std::to_string(azimuth_bins));
-  if (!origin.position.allFinite() || !std::isfinite(origin.heading))
-    throw std::invalid_argument("edf raster: the origin's position and heading must be finite");
+  if (!origin.position.allFinite() || !std::isfinite(origin.heading) || !std::isfinite(origin.ground_z))
+    throw std::invalid_argument("edf raster: the origin's position, heading and ground height must be finite");
+  // One batched query; a mapper that answers a different number of points breaks its contract.
+  auto ask = [&mapper](const std::vector<Eigen::Vector3f>& points, std::vector<DistanceQuery>& answers) {
+    mapper.query(points, answers);
+    if (answers.size() != points.size())
+      throw std::logic_error("edf raster: mapper '" + mapper.name() + "' answered " +
+                             std::to_string(answers.size()) + " of " + std::to_string(points.size()) +
+                             " queries");
+  };
 
   const size_t n = static_cast<size_t>(azimuth_bins);
   EdfRaster out;
@@ -81,7 +89,7 @@ EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimu
     points[k] = (origin.position + config.sample_radius * rays[k]).cast<float>();
     out.bins[k].sample_point = points[k];
   }
-  mapper.query(points, answers);
+  ask(points, answers);
   for (size_t k = 0; k < n; ++k) {
     const DistanceQuery& q = answers[k];
     const Eigen::Vector3d g = q.gradient.cast<double>();
@@ -113,7 +121,7 @@ EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimu
       const size_t r = active[i];
       points[i] = (starts[r / n] + t[r] * rays[r % n]).cast<float>();
     }
-    mapper.query(points, answers);
+    ask(points, answers);
     std::vector<size_t> still;
     for (size_t i = 0; i < active.size(); ++i) {
       const size_t r = active[i];

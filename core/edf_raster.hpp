@@ -71,7 +71,7 @@ struct EdfRaster {
 // circle is at origin.position.z). One Mapper::query call for all sample points, then one per
 // sphere-tracing iteration for all still-active rays (every bin and height), so the result does not depend on how
 // the mapper parallelises its queries. Throws std::invalid_argument on an invalid config,
-// azimuth_bins outside [1, 36000] or a non-finite origin.
+// azimuth_bins outside [1, 36000] or a non-finite origin (position, heading, ground height).
 EdfRaster edf_raster(const Mapper& mapper, const RasterOrigin& origin, int azimuth_bins,
                      const EdfRasterConfig& config = {});
 

@@ -298,6 +298,9 @@ TEST_CASE("EDF: bad configuration or origin is rejected", "[edf_raster][bad_inpu
   bad = o;
   bad.heading = INFINITY;
   CHECK_THROWS_AS(edf_raster(field, bad, 360, {}), std::invalid_argument);
+  bad = o;
+  bad.ground_z = NAN;
+  CHECK_THROWS_AS(edf_raster(field, bad, 360, {}), std::invalid_argument);
 }
 
 TEST_CASE("EDF on a VDB-GPDF map of a box: the traced range at the face is exact within a voxel",
