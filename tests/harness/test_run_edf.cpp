@@ -163,7 +163,8 @@ TEST_CASE("EDF on the smoke room: bearings slip far off the rays, traced ranges 
   const auto& last = frames.back();
   const Eigen::Vector3d eye(std::stod(last.at("x")), std::stod(last.at("y")), std::stod(last.at("z")));
   const auto heights = summary["config"]["edf"]["trace_heights"].get<std::vector<double>>();
-  REQUIRE(heights.size() == 4);  // the default edf.trace_rows
+  REQUIRE(heights.size() == 4);  // the default edf.trace_rows: centres of 4 slices of [0.1, 2.0]
+  for (int j = 0; j < 4; ++j) CHECK(heights[static_cast<size_t>(j)] == Approx(0.1 + (j + 0.5) * 1.9 / 4));
   const double heading = std::stod(last.at("heading_deg")) * M_PI / 180.0;
   const auto scenario = sonomap::harness::load_scenario(o.scenario, o.overrides);
   const auto triangles = sonomap::sim::world_triangles(scenario, std::stod(last.at("time")));
