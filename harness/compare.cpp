@@ -3,6 +3,7 @@
 
 #include "harness/errors.hpp"
 #include "harness/interrupt.hpp"
+#include "harness/output.hpp"
 #include "harness/progress.hpp"
 #include "harness/report.hpp"
 
@@ -10,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fcntl.h>
@@ -99,6 +101,46 @@ void append_frames_list(std::vector<std::string>& args, const char* option,
   for (const auto& f : frames) args.push_back(f);
 }
 
+// The `claims` list: each names a scenario and a variant of this sweep.
+std::vector<Claim> read_sweep_claims(const SweepReader& r, const YAML::Node& root, const Sweep& sweep) {
+  std::vector<Claim> claims;
+  const YAML::Node list = root["claims"];
+  if (!list) return claims;
+  if (!list.IsSequence()) r.fail(list, "claims", "expected a list");
+  std::set<std::string> scenarios, variants;
+  for (const auto& s : root["scenarios"]) scenarios.insert(s["id"].as<std::string>());
+  for (const auto& v : root["variants"]) variants.insert(v["id"].as<std::string>());
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node c = list[i];
+    const std::string key = "claims[" + std::to_string(i) + "]";
+    r.check_keys(c, key, {"text", "scenario", "variant", "metric", "op", "value", "versus", "paper", "note"});
+    for (const char* required : {"text", "scenario", "variant", "metric", "op", "value"})
+      if (!c[required]) r.fail(c, key + "." + required, "missing");
+    Claim claim;
+    claim.text = r.scalar<std::string>(c["text"], key + ".text");
+    claim.scenario = r.scalar<std::string>(c["scenario"], key + ".scenario");
+    if (!scenarios.count(claim.scenario))
+      r.fail(c["scenario"], key + ".scenario", "no scenario '" + claim.scenario + "' in " + sweep.name);
+    claim.variant = r.scalar<std::string>(c["variant"], key + ".variant");
+    if (!variants.count(claim.variant))
+      r.fail(c["variant"], key + ".variant", "no variant '" + claim.variant + "' in " + sweep.name);
+    claim.metric = r.identifier(c["metric"], key + ".metric");
+    claim.op = r.scalar<std::string>(c["op"], key + ".op");
+    if (!is_claim_operator(claim.op)) r.fail(c["op"], key + ".op", "expected >=, <=, > or <");
+    claim.value = r.scalar<double>(c["value"], key + ".value");
+    if (!std::isfinite(claim.value)) r.fail(c["value"], key + ".value", "must be finite");
+    if (c["versus"]) {
+      claim.versus = r.scalar<std::string>(c["versus"], key + ".versus");
+      if (!variants.count(claim.versus))
+        r.fail(c["versus"], key + ".versus", "no variant '" + claim.versus + "' in " + sweep.name);
+    }
+    if (c["paper"]) claim.paper = r.scalar<std::string>(c["paper"], key + ".paper");
+    if (c["note"]) claim.note = r.scalar<std::string>(c["note"], key + ".note");
+    claims.push_back(std::move(claim));
+  }
+  return claims;
+}
+
 }  // namespace
 
 Sweep load_sweep(const fs::path& file, const fs::path& out) {
@@ -112,7 +154,7 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
   }
   SweepReader r(file);
   r.check_keys(root, "", {"name", "frames", "every", "seeds", "set", "scenarios", "variants",
-                          "pictures", "sweeps", "description"});
+                          "pictures", "sweeps", "description", "claims"});
   Sweep sweep;
   if (!root["name"]) r.fail(root, "name", "missing");
   sweep.name = r.identifier(root["name"], "name");
@@ -183,6 +225,7 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
       }
     }
   }
+  sweep.claims = read_sweep_claims(r, root, sweep);
   return sweep;
 }
 
@@ -234,6 +277,10 @@ struct CompareOptions {
 int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   const Sweep sweep = load_sweep(o.sweep_file, o.out);
   const std::string program = self_program();
+  if (!sweep.claims.empty()) {  // `report` reads them from here, whoever runs the jobs
+    fs::create_directories(o.out);
+    write_text_file(o.out / "claims.json", claims_to_json(sweep.claims).dump(2) + "\n");
+  }
   if (o.emit_jobs) {
     std::fputs(job_list(sweep, program).c_str(), stdout);
     return 0;

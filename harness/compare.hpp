@@ -16,8 +16,10 @@
 //     - {id: gpdf_5cm, mapper: vdb_gpdf, voxel: 0.05, set: [mapper.carving=false]}
 //   pictures: [-1]                    # optional, passed to run --pictures
 //   sweeps: [-1]                      # optional, passed to run --sweeps
+//   claims: [...]                     # optional: the paper's figures to check (claims.hpp)
 #pragma once
 
+#include "harness/claims.hpp"
 #include "harness/cli.hpp"
 
 #include <filesystem>
@@ -34,6 +36,7 @@ struct Job {
 struct Sweep {
   std::string name;
   std::vector<Job> jobs;
+  std::vector<Claim> claims;
 };
 
 // Parses and validates a sweep file; job outputs go to <out>/runs/<id>.

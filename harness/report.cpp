@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/report.hpp"
+#include "harness/claims.hpp"
 
 #include "harness/errors.hpp"
 #include "harness/output.hpp"
@@ -207,6 +208,7 @@ int build_report(const fs::path& dir, bool quiet) {
      << "`rollup.csv` has every number below). Coverage: known bins also occupied in the ground "
         "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
         "the estimate but empty in the truth or more than the tolerance closer (conventions.md).\n\n";
+  md << claims_section(read_claims(dir), csv.str());
   for (const auto& [scenario, list] : by_scenario) {
     md << "## " << scenario << "\n\n"
        << "| run | mapper | voxel | circle cov. (final / mean) | circle RMSE (final / mean) | "

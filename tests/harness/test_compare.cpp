@@ -64,3 +64,49 @@ TEST_CASE("a sweep file with an unknown key is rejected with its line", "[compar
   CHECK(r.output.find("varaints") != std::string::npos);
   CHECK(!fs::exists(scratch.path() / "out"));
 }
+
+// The paper's figures as claims: a camera with a 57 degree field of view cannot see the whole
+// circle, and sees well under half of it, whatever the code does; a claim on a column the
+// roll-up does not have is "not measured", never a verdict.
+TEST_CASE("a sweep's claims are checked against the roll-up: agrees, differs, not measured",
+          "[compare][claims]") {
+  sonomap::test::ScratchDir scratch("compare-claims");
+  const std::string claims =
+      "claims:\n"
+      "  - {text: a camera sees under half the circle, scenario: smoke, variant: depth,\n"
+      "     metric: circle_final_coverage, op: '<', value: 0.5, paper: below 20%}\n"
+      "  - {text: a camera sees the whole circle, scenario: smoke, variant: depth,\n"
+      "     metric: circle_final_coverage, op: '>=', value: 0.99}\n"
+      "  - {text: no such figure, scenario: smoke, variant: depth, metric: no_such_column,\n"
+      "     op: '>', value: 0}\n";
+  const fs::path sweep = scratch.write("sweep.yaml", tiny_sweep() + claims);
+  const fs::path out = scratch.path() / "out";
+  const auto r = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", out.string(), "-j", "2"});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const std::string report = sonomap::test::text_of(out / "report.md");
+  INFO(report);
+  CHECK(report.find("## Against the paper") != std::string::npos);
+  CHECK(report.find("| a camera sees under half the circle") != std::string::npos);
+  CHECK(report.find("1 agree, 1 differ, 1 not measured.") != std::string::npos);
+
+  // `report` alone rebuilds the same section from the directory.
+  fs::remove(out / "report.md");
+  REQUIRE(sonomap::test::run_sonomap({"report", out.string()}).status == 0);
+  CHECK(sonomap::test::text_of(out / "report.md") == report);
+}
+
+TEST_CASE("a claim naming a variant the sweep does not have is rejected with its line and key",
+          "[compare][claims]") {
+  sonomap::test::ScratchDir scratch("compare-claims-bad");
+  const fs::path sweep = scratch.write(
+      "sweep.yaml", tiny_sweep() +
+                        "claims:\n"
+                        "  - {text: t, scenario: smoke, variant: depth, metric: circle_final_coverage,\n"
+                        "     op: '<', value: 1, versus: gpdf}\n");
+  const auto r = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", (scratch.path() / "out").string()});
+  CHECK(r.status == 2);
+  CHECK(r.output.find("sweep.yaml:14") != std::string::npos);  // the line of `versus`
+  CHECK(r.output.find("claims[0].versus") != std::string::npos);
+  CHECK(!fs::exists(scratch.path() / "out"));
+}
