@@ -22,19 +22,6 @@ struct BenchSonifyOptions {
   int repetitions = 30;
 };
 
-// Process CPU time, ms: on a busy machine wall time includes waiting for a core.
-double cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 // The listener in the middle of a 5 x 4 m room: every bin sees a wall 2..3.2 m away, so all
 // 36 sectors tap, over several BRIR distances.
 Circle room_circle() {
@@ -73,13 +60,13 @@ void bench_sonify(const BenchSonifyOptions& o, const GlobalOptions& global) {
     for (int i = 0; i < o.repetitions; ++i) {
       renderer.clear_cache();
       const auto a = std::chrono::steady_clock::now();
-      const double ca = cpu_ms();
+      const double ca = process_cpu_ms();
       const audio::SweepAudio cold = renderer.render(circle);
       const auto b = std::chrono::steady_clock::now();
-      const double cb = cpu_ms();
+      const double cb = process_cpu_ms();
       const audio::SweepAudio warm = renderer.render(circle);
       const auto c = std::chrono::steady_clock::now();
-      const double cc = cpu_ms();
+      const double cc = process_cpu_ms();
       uncached.push_back(std::chrono::duration<double, std::milli>(b - a).count());
       cached.push_back(std::chrono::duration<double, std::milli>(c - b).count());
       uncached_cpu.push_back(cb - ca);
