@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The whole chain: sensor -> mapper -> rasters -> ground truth -> metrics -> result directory.
 #include "cli_support.hpp"
+#include "run_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include "harness/run.hpp"
@@ -16,25 +17,6 @@ using sonomap::test::ScratchDir;
 
 namespace {
 
-// The smoke scene at a quarter of the pixels: the same geometry, a quarter of the rays.
-std::vector<std::string> small_camera() {
-  return {"sensor.width=320", "sensor.height=240", "sensor.intrinsics.fx=262.5",
-          "sensor.intrinsics.fy=262.5", "sensor.intrinsics.cx=159.5", "sensor.intrinsics.cy=119.5"};
-}
-
-sonomap::harness::RunOptions smoke_options(const fs::path& out, const std::string& mapper, int frames) {
-  sonomap::harness::RunOptions o;
-  o.scenario = sonomap::test::shipped("scenes/smoke.yaml");
-  o.out = out;
-  o.mapper = mapper;
-  o.frames = frames;
-  o.overrides = small_camera();
-  o.picture_frames = {-1};
-  o.sweep_frames = {-1};
-  o.quiet = true;
-  return o;
-}
-
 std::vector<std::string> lines_of(const fs::path& file) {
   std::istringstream in(sonomap::test::text_of(file));
   std::vector<std::string> lines;
@@ -47,7 +29,7 @@ std::vector<std::string> lines_of(const fs::path& file) {
 TEST_CASE("a run writes one row per evaluated frame and a full circle and cylinder for each",
           "[run]") {
   ScratchDir scratch("run-layout");
-  auto o = smoke_options(scratch.path() / "out", "depth_only", 12);
+  auto o = sonomap::test::smoke_run(scratch.path() / "out", "depth_only", 12);
   o.every = 5;  // frames 0, 5, 10 and the last (11)
   sonomap::harness::run_scenario(o);
   const fs::path dir = o.out;
@@ -75,7 +57,7 @@ TEST_CASE("the depth-only circle in the room covers about one camera view, well 
   o.mapper = "depth_only";
   o.frames = 60;
   o.every = 10;
-  o.overrides = small_camera();
+  o.overrides = sonomap::test::small_camera();
   o.picture_frames = {-1};
   o.sweep_frames = {-1};
   o.quiet = true;
@@ -92,7 +74,7 @@ TEST_CASE("results are byte-identical across reruns and across 1 and 2 threads",
   std::vector<fs::path> dirs;
   for (int threads : {1, 2, 2}) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-    auto o = smoke_options(scratch.path() / ("out" + std::to_string(dirs.size())), "vdb_gpdf", 10);
+    auto o = sonomap::test::smoke_run(scratch.path() / ("out" + std::to_string(dirs.size())), "vdb_gpdf", 10);
     o.every = 3;
     sonomap::harness::run_scenario(o);
     dirs.push_back(o.out);
@@ -145,7 +127,7 @@ TEST_CASE("regression: VDB-GPDF on the smoke scene keeps its coverage, accuracy 
   // truth has it and the map reads the wall behind. Margins: 2 points of coverage, 20% of
   // RMSE, 2 ghost bins. A change that makes the map worse than this fails.
   ScratchDir scratch("run-regression");
-  auto o = smoke_options(scratch.path() / "out", "vdb_gpdf", 60);
+  auto o = sonomap::test::smoke_run(scratch.path() / "out", "vdb_gpdf", 60);
   o.every = 6;
   const json m = sonomap::harness::run_scenario(o).summary["metrics"];
   CHECK(m["circle"]["final"]["coverage"].get<double>() >= 0.344);

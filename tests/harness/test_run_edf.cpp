@@ -3,6 +3,7 @@
 // on the smoke room the field's bearings slip far off the rays, while its sphere-traced ranges
 // meet the true surfaces; the truth is an exact ray cast against the scene's own triangles.
 #include "cli_support.hpp"
+#include "run_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include "harness/errors.hpp"
@@ -27,22 +28,9 @@ using sonomap::test::ScratchDir;
 
 namespace {
 
-std::vector<std::string> small_camera() {
-  return {"sensor.width=320", "sensor.height=240", "sensor.intrinsics.fx=262.5",
-          "sensor.intrinsics.fy=262.5", "sensor.intrinsics.cx=159.5", "sensor.intrinsics.cy=119.5"};
-}
-
 sonomap::harness::RunOptions smoke(const fs::path& out, const std::string& mapper, int frames) {
-  sonomap::harness::RunOptions o;
-  o.scenario = sonomap::test::shipped("scenes/smoke.yaml");
-  o.out = out;
-  o.mapper = mapper;
-  o.frames = frames;
-  o.overrides = small_camera();
-  o.picture_frames = {-1};
-  o.sweep_frames = {-1};
+  auto o = sonomap::test::smoke_run(out, mapper, frames);
   o.write_rasters = false;
-  o.quiet = true;
   return o;
 }
 
