@@ -5,7 +5,13 @@
 #include "test_scenario_files.hpp"
 
 #include <algorithm>
+#include <csignal>
 #include <sstream>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
 
 namespace fs = std::filesystem;
 
@@ -109,4 +115,64 @@ TEST_CASE("a claim naming a variant the sweep does not have is rejected with its
   CHECK(r.output.find("sweep.yaml:14") != std::string::npos);  // the line of `versus`
   CHECK(r.output.find("claims[0].versus") != std::string::npos);
   CHECK(!fs::exists(scratch.path() / "out"));
+}
+
+// Ctrl-C during a sweep: the sweep stops with status 130, the runs that finished stay, the one
+// that was running leaves no partial directory, and a rerun runs only what is missing.
+TEST_CASE("an interrupted sweep keeps its finished runs, leaves no partial one, and resumes",
+          "[compare][interrupt]") {
+  const char* exe = std::getenv("SONOMAP_EXE");
+  REQUIRE(exe);
+  sonomap::test::ScratchDir scratch("compare-interrupt");
+  const std::string sweep_text =
+      "name: long\n"
+      "frames: 150\n"
+      "set: [sensor.width=160, sensor.height=120, sensor.intrinsics.fx=131.25,\n"
+      "      sensor.intrinsics.fy=131.25, sensor.intrinsics.cx=79.5, sensor.intrinsics.cy=59.5]\n"
+      "scenarios:\n"
+      "  - {id: room, file: " + sonomap::test::shipped("scenes/room.yaml").string() + "}\n"
+      "variants:\n"
+      "  - {id: a, mapper: vdb_gpdf, voxel: 0.1}\n"
+      "  - {id: b, mapper: vdb_gpdf, voxel: 0.15}\n"
+      "  - {id: c, mapper: vdb_gpdf, voxel: 0.2}\n"
+      "  - {id: d, mapper: vdb_gpdf, voxel: 0.25}\n"
+      "pictures: [-1]\n"
+      "sweeps: [-1]\n";
+  const fs::path sweep = scratch.write("sweep.yaml", sweep_text);
+  const fs::path out = scratch.path() / "out";
+  std::vector<std::string> args{exe, "--quiet", "compare", sweep.string(), "--out", out.string()};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  REQUIRE(posix_spawn(&pid, exe, nullptr, nullptr, argv.data(), environ) == 0);
+
+  // Interrupt as soon as the first run has finished (its directory appears whole).
+  auto finished = [&] {
+    int n = 0;
+    if (fs::exists(out / "runs"))
+      for (const auto& e : fs::directory_iterator(out / "runs"))
+        if (fs::exists(e.path() / "summary.json")) ++n;
+    return n;
+  };
+  for (int waited_ms = 0; finished() == 0 && waited_ms < 300000; waited_ms += 20) usleep(20000);
+  REQUIRE(finished() >= 1);
+  ::kill(pid, SIGINT);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  const int kept = finished();
+  INFO("finished runs when interrupted: " << kept);
+  REQUIRE(kept < 4);  // the sweep had not finished, so the interrupt was tested
+  CHECK(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  for (const auto& e : fs::directory_iterator(out / "runs")) {
+    INFO(e.path());
+    CHECK(fs::exists(e.path() / "summary.json"));  // no partial directory left behind
+  }
+
+  const auto resumed = sonomap::test::run_sonomap({"compare", sweep.string(), "--out", out.string(), "-j", "2"});
+  CHECK(resumed.status == 0);
+  CHECK(resumed.output.find(std::to_string(kept) + " finished before, " + std::to_string(4 - kept) +
+                            " to run") != std::string::npos);
+  CHECK(finished() == 4);
 }
