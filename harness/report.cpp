@@ -70,7 +70,7 @@ std::vector<RunRecord> read_runs(const fs::path& dir) {
   return runs;
 }
 
-std::string number(const json& v, const char* format = "{:.4f}") {
+std::string number(const json& v, const char* format = "{:.6g}") {
   return v.is_number() ? fmt::format(fmt::runtime(format), v.get<double>()) : "";
 }
 
