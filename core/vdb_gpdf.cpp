@@ -341,11 +341,21 @@ void VdbGpdf::integrate(const Frame& frame) {
       const Eigen::Vector3d s0 = (p + start * u) / vg;
       const Ray ray(openvdb::Vec3d(s0.x(), s0.y(), s0.z()), openvdb::Vec3d(u.x(), u.y(), u.z()),
                     0.0, (range - start) / vg);
-      openvdb::math::DDA<Ray, 0> dda(ray);
+      // Two levels: leaf blocks first, voxels only inside blocks that exist (observed voxels
+      // lie near surfaces, so most of a ray crosses no block at all).
+      openvdb::math::DDA<Ray, 3> blocks(ray);
       do {
-        const openvdb::Coord v = dda.voxel();
-        if (observed.getValue(v)[1] > 0.0f) carved[leaf].push_back(v);
-      } while (dda.step());
+        const openvdb::Coord block = blocks.voxel();
+        if (!observed.probeConstLeaf(block)) continue;
+        Ray inside(ray);
+        inside.setTimes(blocks.time(), std::min(blocks.next(), ray.t1()));
+        openvdb::math::DDA<Ray, 0> dda(inside);
+        do {
+          const openvdb::Coord v = dda.voxel();
+          // A voxel on the block's edge may round into the neighbour: that block visits it.
+          if (leaf_origin_of(v) == block && observed.getValue(v)[1] > 0.0f) carved[leaf].push_back(v);
+        } while (dda.step());
+      } while (blocks.step());
     }
   });
   updates.push_back(carving_updates(config_, carved, locals));
