@@ -107,6 +107,9 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
   for (int dx = -kNormalReach; dx <= kNormalReach; ++dx)
     for (int dy = -kNormalReach; dy <= kNormalReach; ++dy)
       for (int dz = -kNormalReach; dz <= kNormalReach; ++dz) {
+        // A ball, not the cube: the cube's corners add a third more probes and bias the
+        // neighbourhood toward the grid's diagonals.
+        if (dx * dx + dy * dy + dz * dz > kNormalReach * kNormalReach + 1) continue;
         openvdb::Vec4f cell;
         if (!local.probeValue(c.offsetBy(dx, dy, dz), cell)) continue;
         const Eigen::Vector3d d = centroid(cell) - p;  // relative to p: well conditioned
