@@ -54,6 +54,14 @@ class Mapper {
   virtual size_t memory_bytes() const { return 0; }
 };
 
+// A config checked by its validate() (which throws std::invalid_argument), for use in a
+// mapper's member initialisers before anything is built from it.
+template <typename Config>
+const Config& validated(const Config& config) {
+  config.validate();
+  return config;
+}
+
 // Rejects a pose a mapper must not fuse: non-finite, or a rotation that is not orthonormal
 // with determinant +1 (tolerance 1e-3). Throws std::invalid_argument naming the frame.
 inline void check_pose(const Frame& frame) {

@@ -3,20 +3,18 @@
 
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
+#include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
 
 namespace sonomap {
 
 namespace {
 using Clock = StageClock;
-constexpr float kUnobservedDistance = -100.0f;
 }  // namespace
 
 void TsdfConfig::validate() const {
@@ -30,11 +28,8 @@ void TsdfConfig::validate() const {
     fail("need 0 <= min_range < max_range");
 }
 
-Tsdf::Tsdf(TsdfConfig config) : config_(config), cache_(kLeafDim * config.voxel) {
-  config_.validate();
-  openvdb::initialize();
-  grid_ = DistanceWeightGrid::create(openvdb::Vec2s(kUnobservedDistance, 0.0f));
-}
+Tsdf::Tsdf(TsdfConfig config)
+    : config_(validated(config)), fused_(config.voxel, static_cast<float>(config.min_weight)) {}
 
 void Tsdf::integrate(const Frame& frame) {
   check_pose(frame);
@@ -48,7 +43,7 @@ void Tsdf::integrate(const Frame& frame) {
 
   auto t0 = Clock::now();
   openvdb::MaskGrid touched(false);
-  auto acc = grid_->getAccessor();
+  auto acc = fused_.grid().getAccessor();
   auto touch = touched.getAccessor();
   using Ray = openvdb::math::Ray<double>;
   for (const auto& p : points) {
@@ -78,24 +73,14 @@ void Tsdf::integrate(const Frame& frame) {
   times_.stages.emplace_back("integrate", ms_since(t0));
 
   t0 = Clock::now();
-  const std::vector<openvdb::Coord> dirty = dirty_leaves(touched);
-  std::vector<std::vector<Eigen::Vector3f>> samples(dirty.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, dirty.size()),
-                    [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i != r.end(); ++i) {
-                        SurfaceMesh mesh;
-                        march_leaf(*grid_, dirty[i], voxel, static_cast<float>(config_.min_weight), mesh);
-                        sample_surface(mesh, 0.5 * voxel, samples[i]);
-                      }
-                    });
-  for (size_t i = 0; i < dirty.size(); ++i) cache_.set(dirty[i], std::move(samples[i]));
+  fused_.refresh(dirty_leaves(touched));
   times_.stages.emplace_back("surface", ms_since(t0));
   times_.stages.emplace_back("total", ms_since(t_start));
 }
 
 void Tsdf::surface_points(const Eigen::Vector3d& center, double radius,
                           std::vector<Eigen::Vector3f>& out) const {
-  cache_.collect(center, radius, out);
+  fused_.surface_points(center, radius, out);
 }
 
 DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
@@ -106,7 +91,7 @@ DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
   const Eigen::Vector3d f = g - base;
   const openvdb::Coord b(static_cast<int>(base.x()), static_cast<int>(base.y()),
                          static_cast<int>(base.z()));
-  auto acc = grid_->getConstAccessor();
+  auto acc = fused_.grid().getConstAccessor();
   double d = 0.0;
   Eigen::Vector3d grad = Eigen::Vector3d::Zero();
   for (int c = 0; c < 8; ++c) {
@@ -129,17 +114,12 @@ DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
 void Tsdf::query(const std::vector<Eigen::Vector3f>& points,
                  std::vector<DistanceQuery>& out) const {
   out.assign(points.size(), DistanceQuery{});
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size()),
-                    [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t i = r.begin(); i != r.end(); ++i) out[i] = query_point(points[i]);
-                    });
+  parallel_for_each_index(points.size(), [&](size_t i) { out[i] = query_point(points[i]); });
 }
 
 void Tsdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                         std::vector<Eigen::Vector3i>& triangles) const {
-  SurfaceMesh mesh = march_grid(*grid_, config_.voxel, static_cast<float>(config_.min_weight));
-  vertices = std::move(mesh.vertices);
-  triangles = std::move(mesh.triangles);
+  fused_.surface_mesh(vertices, triangles);
 }
 
 std::vector<std::pair<std::string, std::string>> Tsdf::config_entries() const {
@@ -154,7 +134,7 @@ std::vector<std::pair<std::string, std::string>> Tsdf::config_entries() const {
 }
 
 size_t Tsdf::memory_bytes() const {
-  return static_cast<size_t>(grid_->memUsage()) + cache_.sample_count() * sizeof(Eigen::Vector3f);
+  return fused_.memory_bytes();
 }
 
 }  // namespace sonomap

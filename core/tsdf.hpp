@@ -6,7 +6,7 @@
 #pragma once
 
 #include "core/mapper.hpp"
-#include "core/marching_cubes.hpp"
+#include "core/fused_grid.hpp"
 
 namespace sonomap {
 
@@ -39,13 +39,12 @@ class Tsdf final : public Mapper {
   size_t memory_bytes() const override;
 
   const TsdfConfig& config() const { return config_; }
-  const DistanceWeightGrid& grid() const { return *grid_; }
+  const DistanceWeightGrid& grid() const { return fused_.grid(); }
   DistanceQuery query_point(const Eigen::Vector3f& x) const;
 
  private:
   TsdfConfig config_;
-  DistanceWeightGrid::Ptr grid_;
-  SurfaceCache cache_;
+  FusedGrid fused_;
   StageTimes times_;
 };
 

@@ -4,8 +4,6 @@
 #include <Eigen/Eigenvalues>
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +12,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "core/parallel.hpp"
 #include "core/stopwatch.hpp"
 
 namespace sonomap {
@@ -21,18 +20,10 @@ namespace {
 
 using Clock = StageClock;
 
-constexpr float kUnobservedDistance = -100.0f;
 constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("VdbGpdfConfig: " + what);
-}
-
-template <typename F>
-void parallel_for_each_index(size_t n, F&& f) {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) f(i);
-  });
 }
 
 Eigen::Vector3d voxel_centre(const openvdb::Coord& ijk, double voxel) {
@@ -223,11 +214,8 @@ double carving_frame_bound(double weight_cap, double d_old, double carve) {
 }
 
 VdbGpdf::VdbGpdf(VdbGpdfConfig config)
-    : config_(config), cache_(kLeafDim * config.global_voxel) {
-  config_.validate();
-  openvdb::initialize();
-  grid_ = DistanceWeightGrid::create(openvdb::Vec2s(kUnobservedDistance, 0.0f));
-}
+    : config_(validated(config)),
+      fused_(config.global_voxel, static_cast<float>(config.recon_min_weight)) {}
 
 VdbGpdf::~VdbGpdf() = default;
 
@@ -282,7 +270,7 @@ void VdbGpdf::integrate(const Frame& frame) {
   std::vector<std::vector<QueryUpdate>> updates(training.size());
   std::vector<std::vector<openvdb::Coord>> carved(training.size());  // voxels each leaf's rays cross
   parallel_for_each_index(training.size(), [&](size_t leaf) {
-    auto observed = grid_->getConstAccessor();
+    auto observed = fused_.grid().getConstAccessor();
     auto local_acc = local.getConstAccessor();
     auto& out = updates[leaf];
     const double vg = config_.global_voxel;
@@ -377,7 +365,7 @@ void VdbGpdf::integrate(const Frame& frame) {
       }
   }
   {
-    auto acc = grid_->getAccessor();
+    auto acc = fused_.grid().getAccessor();
     const bool capped = config_.weight_cap > 0.0;
     for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
       for (auto v = leaf->cbeginValueOn(); v; ++v) {
@@ -408,16 +396,8 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
     touched_count[leaf->origin()] = static_cast<int>(leaf->onVoxelCount());
   const std::vector<openvdb::Coord> dirty = dirty_leaves(touched);
 
-  const double voxel = config_.global_voxel;
-  const float min_weight = static_cast<float>(config_.recon_min_weight);
-  std::vector<SurfaceMesh> meshes(dirty.size());
-  std::vector<std::vector<Eigen::Vector3f>> samples(dirty.size());
-  parallel_for_each_index(dirty.size(), [&](size_t i) {
-    march_leaf(*grid_, dirty[i], voxel, min_weight, meshes[i]);
-    sample_surface(meshes[i], 0.5 * voxel, samples[i]);
-  });
+  std::vector<SurfaceMesh> meshes = fused_.refresh(dirty);
   for (size_t i = 0; i < dirty.size(); ++i) {
-    cache_.set(dirty[i], std::move(samples[i]));
     const auto count = touched_count.find(dirty[i]);
     if (count == touched_count.end() || count->second < config_.g_gpdf_min_touched) continue;
     if (meshes[i].vertices.empty()) {
@@ -425,7 +405,7 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
       continue;
     }
     auto leaf = std::make_unique<GlobalLeaf>();
-    leaf->centre = leaf_centre(dirty[i], voxel);
+    leaf->centre = leaf_centre(dirty[i], config_.global_voxel);
     leaf->crossings = std::move(meshes[i].vertices);
     global_[dirty[i]] = std::move(leaf);
   }
@@ -433,7 +413,7 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
 
 void VdbGpdf::surface_points(const Eigen::Vector3d& center, double radius,
                              std::vector<Eigen::Vector3f>& out) const {
-  cache_.collect(center, radius, out);
+  fused_.surface_points(center, radius, out);
 }
 
 DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
@@ -529,10 +509,7 @@ void VdbGpdf::query(const std::vector<Eigen::Vector3f>& points,
 
 void VdbGpdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                            std::vector<Eigen::Vector3i>& triangles) const {
-  SurfaceMesh mesh =
-      march_grid(*grid_, config_.global_voxel, static_cast<float>(config_.recon_min_weight));
-  vertices = std::move(mesh.vertices);
-  triangles = std::move(mesh.triangles);
+  fused_.surface_mesh(vertices, triangles);
 }
 
 std::vector<std::pair<std::string, std::string>> VdbGpdf::config_entries() const {
@@ -564,8 +541,7 @@ std::vector<std::pair<std::string, std::string>> VdbGpdf::config_entries() const
 }
 
 size_t VdbGpdf::memory_bytes() const {
-  size_t bytes = static_cast<size_t>(grid_->memUsage());
-  bytes += cache_.sample_count() * sizeof(Eigen::Vector3f);
+  size_t bytes = fused_.memory_bytes();
   for (const auto& kv : global_) {
     const size_t n = kv.second->crossings.size();
     bytes += sizeof(GlobalLeaf) + n * sizeof(Eigen::Vector3f);

@@ -5,6 +5,7 @@
 // and a global GP per leaf trained on the marching-cubes zero crossings (G-GPDF).
 #pragma once
 
+#include "core/fused_grid.hpp"
 #include "core/gp.hpp"
 #include "core/mapper.hpp"
 #include "core/marching_cubes.hpp"
@@ -75,7 +76,7 @@ class VdbGpdf final : public Mapper {
 
   const VdbGpdfConfig& config() const { return config_; }
   // The fused global grid: x = signed distance (background -100), y = weight (background 0).
-  const DistanceWeightGrid& grid() const { return *grid_; }
+  const DistanceWeightGrid& grid() const { return fused_.grid(); }
   size_t global_gp_count() const { return global_.size(); }
   DistanceQuery query_point(const Eigen::Vector3f& x) const;
 
@@ -89,9 +90,8 @@ class VdbGpdf final : public Mapper {
                                          const std::vector<const GlobalLeaf*>& leaves) const;
 
   VdbGpdfConfig config_;
-  DistanceWeightGrid::Ptr grid_;
+  FusedGrid fused_;
   std::unordered_map<openvdb::Coord, std::unique_ptr<GlobalLeaf>, CoordHash> global_;
-  SurfaceCache cache_;
   StageTimes times_;
 };
 

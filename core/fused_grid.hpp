@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The grid both volumetric maps fuse into, (signed distance, weight) per voxel, with its
+// surface: marching cubes over the voxels observed with at least `min_weight`, kept as
+// per-leaf samples for the rasters (refreshed only where a frame touched) and as a mesh.
+#pragma once
+
+#include "core/marching_cubes.hpp"
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace sonomap {
+
+class FusedGrid {
+ public:
+  static constexpr float kUnobservedDistance = -100.0f;  // background: never observed
+
+  FusedGrid(double voxel, float min_weight);
+  double voxel() const { return voxel_; }
+  DistanceWeightGrid& grid() { return *grid_; }
+  const DistanceWeightGrid& grid() const { return *grid_; }
+
+  // Re-marches the given leaves (in parallel) and replaces their surface samples; returns
+  // each leaf's mesh (empty where the leaf holds no surface).
+  std::vector<SurfaceMesh> refresh(const std::vector<openvdb::Coord>& leaves);
+  // Surface samples within horizontal distance `radius` of center, at most half a voxel apart.
+  void surface_points(const Eigen::Vector3d& center, double radius,
+                      std::vector<Eigen::Vector3f>& out) const;
+  void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
+                    std::vector<Eigen::Vector3i>& triangles) const;
+  size_t memory_bytes() const;
+
+ private:
+  double voxel_;
+  float min_weight_;
+  DistanceWeightGrid::Ptr grid_;
+  SurfaceCache cache_;
+};
+
+}  // namespace sonomap
