@@ -307,8 +307,8 @@ void VdbGpdf::integrate(const Frame& frame) {
       const Eigen::Vector3d normal =
           surface_normal(local_acc, voxel_of(p, config_.local_voxel), p, u);
       {
-        const int gp = locals.nearest(p);
-        const GpPrediction pred = locals.gps[gp].predict(p, config_.inverse_variance_fusion);
+        // p is a centroid inside this leaf, so this leaf's GP is its nearest: no lookup.
+        const GpPrediction pred = locals.gps[leaf].predict(p, config_.inverse_variance_fusion);
         const double d = pred.valid ? pred.distance : 0.0;
         fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
              pred.valid ? pred.variance : config_.variance_on_surface);
