@@ -5,8 +5,8 @@
 // distance along the ray in a running weighted average.
 #pragma once
 
-#include "core/mapper.hpp"
 #include "core/fused_grid.hpp"
+#include "core/mapper.hpp"
 
 namespace sonomap {
 

@@ -2,7 +2,7 @@
 // Running the sonomap executable from tests (SONOMAP_EXE is set by ctest), without a shell.
 #pragma once
 
-#include "harness/subprocess.hpp"
+#include "harness/support/subprocess.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,7 @@
 // Short runs of the shipped smoke scene for the run tests, at a quarter of the pixels.
 #pragma once
 
-#include "harness/run.hpp"
+#include "harness/app/run.hpp"
 #include "test_scenario_files.hpp"
 
 #include <filesystem>

@@ -5,7 +5,7 @@
 // straight ahead there is no interaural difference.
 #include "audio/brir_synth.hpp"
 #include "audio/sweep.hpp"
-#include "harness/sofa_io.hpp"
+#include "harness/formats/sofa_io.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -2,7 +2,7 @@
 // `sonomap render` and the TUM RGB-D sequence it writes: depth PNGs hold the known wall
 // distance, poses are the true camera poses, the reader gets back what was written, and bad
 // input exits with status 2 leaving nothing behind.
-#include "harness/tum_io.hpp"
+#include "harness/formats/tum_io.hpp"
 #include "test_scenario_files.hpp"
 
 #include <catch2/catch.hpp>

@@ -4,7 +4,7 @@
 #include "run_support.hpp"
 #include "test_scenario_files.hpp"
 
-#include "harness/run.hpp"
+#include "harness/app/run.hpp"
 
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>

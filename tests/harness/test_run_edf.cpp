@@ -6,10 +6,10 @@
 #include "run_support.hpp"
 #include "test_scenario_files.hpp"
 
-#include "harness/errors.hpp"
-#include "harness/report.hpp"
-#include "harness/run.hpp"
-#include "harness/scenario_yaml.hpp"
+#include "harness/app/run.hpp"
+#include "harness/formats/scenario_yaml.hpp"
+#include "harness/report/report.hpp"
+#include "harness/support/errors.hpp"
 #include "sim/world_geometry.hpp"
 
 #include <fmt/format.h>

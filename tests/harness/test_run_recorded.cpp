@@ -5,7 +5,7 @@
 #include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
-#include "harness/run.hpp"
+#include "harness/app/run.hpp"
 
 #include <map>
 #include <nlohmann/json.hpp>

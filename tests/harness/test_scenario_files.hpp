@@ -2,7 +2,7 @@
 // Helpers for the scenario and render tests: scratch directories and small files.
 #pragma once
 
-#include "harness/errors.hpp"
+#include "harness/support/errors.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The shipped scenes parse and hold what their comments promise: the Cow-and-Lady-sized room,
 // obstacle sizes, a full look-around, a person crossing the view.
-#include "harness/scenario_yaml.hpp"
+#include "harness/formats/scenario_yaml.hpp"
 #include "sim/trajectory.hpp"
 #include "test_scenario_files.hpp"
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Scenario files: what a valid file turns into, and that every kind of bad input is an
 // InputError naming the file, the line and the dotted key.
-#include "harness/scenario_yaml.hpp"
+#include "harness/formats/scenario_yaml.hpp"
 #include "sim/trajectory.hpp"
 #include "test_scenario_files.hpp"
 

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // SOFA files: what we write, libmysofa loads back sample for sample; measured HRIR sets load;
 // malformed files end in a clear error, never a crash.
+#include "harness/formats/sofa_io.hpp"
+#include "harness/support/errors.hpp"
 #include "test_scenario_files.hpp"
-#include "harness/errors.hpp"
-#include "harness/sofa_io.hpp"
 
 #include <catch2/catch.hpp>
 

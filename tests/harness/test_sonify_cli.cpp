@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `sonomap sonify` and `sonomap brir` end to end: outputs on success; on bad input a clear
 // message, exit status 2 and no WAV (not even a partial one).
+#include "harness/formats/circle_io.hpp"
+#include "harness/formats/sofa_io.hpp"
+#include "harness/formats/wav_io.hpp"
+#include "harness/support/errors.hpp"
 #include "test_scenario_files.hpp"
-#include "harness/circle_io.hpp"
-#include "harness/errors.hpp"
-#include "harness/sofa_io.hpp"
-#include "harness/wav_io.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/primitives.hpp"
-#include "sim/world_geometry.hpp"
 #include "sim/trajectory.hpp"
+#include "sim/world_geometry.hpp"
 
 #include <catch2/catch.hpp>
 

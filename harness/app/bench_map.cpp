@@ -1,0 +1,451 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// `sonomap bench map`: median time per frame of each mapping stage (VDB-GPDF: local GPs, query
+// points, fusion, G-GPDF; every mapper: the circle and cylinder rasters) at several voxel sizes
+// and thread counts, against Open3D's ScalableTSDFVolume integrating the same frames in the same
+// process. The machine is shared and noisy: what counts are medians and the ratios to the
+// reference measured alongside, not single absolute times.
+#include "harness/app/bench.hpp"
+
+#include "core/rasteriser.hpp"
+#include "core/stopwatch.hpp"
+#include "harness/app/mapper_factory.hpp"
+#include "harness/app/run.hpp"
+#include "harness/formats/scenario_yaml.hpp"
+#include "harness/support/errors.hpp"
+#include "harness/support/output.hpp"
+#include "harness/support/progress.hpp"
+#include "sim/simulation.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <omp.h>
+#include <open3d/camera/PinholeCameraIntrinsic.h>
+#include <open3d/geometry/Image.h>
+#include <open3d/geometry/KDTreeFlann.h>
+#include <open3d/geometry/RGBDImage.h>
+#include <open3d/geometry/TriangleMesh.h>
+#include <open3d/pipelines/integration/ScalableTSDFVolume.h>
+#include <open3d/pipelines/integration/UniformTSDFVolume.h>
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sonomap::harness {
+
+namespace {
+
+namespace integration = open3d::pipelines::integration;
+using nlohmann::json;
+
+constexpr const char* kOpen3d = "open3d";
+// Open3D's truncation in voxels: the same as our TSDF peer's default (0.15 m at 0.05 m).
+constexpr double kOpen3dTruncationVoxels = 3.0;
+
+struct BenchMapOptions {
+  std::string scenario = "scenes/room.yaml";
+  int frames = 60;
+  // Room: the listener turns once in 30 s (900 frames), so 60 frames 15 apart see every side.
+  int every = 15;
+  std::vector<double> voxels{0.05, 0.10, 0.15};
+  std::vector<int> threads{1, 2};
+  std::vector<std::string> mappers{"vdb_gpdf", "tsdf", kOpen3d};
+  std::string json;
+};
+
+// Stage name and wall time in ms, in the order the stages ran.
+using StageList = std::vector<std::pair<std::string, double>>;
+
+// A map under test: fuses one frame and reports the time of each of its stages. Every map
+// reports "map" (the whole fusion) and "frame" (everything a frame costs, rasters included).
+class BenchedMap {
+ public:
+  virtual ~BenchedMap() = default;
+  virtual void process(const Frame& frame, StageList& stages) = 0;
+  virtual size_t memory_bytes() const = 0;
+};
+
+// One of our mappers, followed by the circle and cylinder exactly as `run` builds them.
+class OurMap final : public BenchedMap {
+ public:
+  OurMap(std::unique_ptr<Mapper> mapper, double ground_z)
+      : mapper_(std::move(mapper)), ground_z_(ground_z) {}
+
+  void process(const Frame& frame, StageList& stages) override {
+    auto t0 = StageClock::now();
+    mapper_->integrate(frame);
+    const double map_ms = ms_since(t0);
+    for (const auto& stage : mapper_->last_stage_times().stages)
+      if (stage.first != "total") stages.push_back(stage);
+    t0 = StageClock::now();
+    rasterise_map(*mapper_, raster_origin(frame.world_T_body, ground_z_), rasteriser_, surface_);
+    const double raster_ms = ms_since(t0);
+    stages.emplace_back("raster", raster_ms);
+    stages.emplace_back("map", map_ms);
+    stages.emplace_back("frame", map_ms + raster_ms);
+  }
+  size_t memory_bytes() const override { return mapper_->memory_bytes(); }
+  const Mapper& mapper() const { return *mapper_; }
+
+ private:
+  std::unique_ptr<Mapper> mapper_;
+  double ground_z_;
+  Rasteriser rasteriser_;
+  std::vector<Eigen::Vector3f> surface_;
+};
+
+// The reference: Open3D's ScalableTSDFVolume (16^3 voxel units, no colour). Its timed cost is
+// the whole hand-over of a frame, as our mappers' is: copying our depth image into an Open3D
+// image and building the RGBDImage ("convert"), then Integrate (back-projection included).
+class Open3dMap final : public BenchedMap {
+ public:
+  Open3dMap(double voxel, const sim::CameraSpec& camera)
+      : volume_(voxel, kOpen3dTruncationVoxels * voxel, integration::TSDFVolumeColorType::NoColor),
+        intrinsic_(camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy),
+        depth_trunc_(camera.max_range) {
+    colour_.Prepare(camera.width, camera.height, 1, 1);  // Open3D wants one; NoColor ignores it
+  }
+
+  void process(const Frame& frame, StageList& stages) override {
+    if (frame.depth.size() != static_cast<size_t>(intrinsic_.width_) * intrinsic_.height_)
+      throw std::runtime_error(fmt::format("bench map: frame {} has {} depth pixels, the camera {}x{}",
+                                           frame.index, frame.depth.size(), intrinsic_.width_,
+                                           intrinsic_.height_));
+    auto t0 = StageClock::now();
+    open3d::geometry::Image depth;
+    depth.Prepare(frame.width, frame.height, 1, 4);  // float metres, 0 = no return
+    std::memcpy(depth.data_.data(), frame.depth.data(), frame.depth.size() * sizeof(float));
+    const auto rgbd = open3d::geometry::RGBDImage::CreateFromColorAndDepth(
+        colour_, depth, /*depth_scale=*/1.0, depth_trunc_, /*convert_rgb_to_intensity=*/false);
+    const double convert_ms = ms_since(t0);
+    t0 = StageClock::now();
+    // Open3D's extrinsic is camera_T_world; its camera frame (x right, y down, z forward) is
+    // our optical frame (conventions.md).
+    volume_.Integrate(*rgbd, intrinsic_, frame.world_T_camera.inverse().matrix());
+    const double integrate_ms = ms_since(t0);
+    stages.emplace_back("convert", convert_ms);
+    stages.emplace_back("integrate", integrate_ms);
+    stages.emplace_back("map", convert_ms + integrate_ms);
+    stages.emplace_back("frame", convert_ms + integrate_ms);
+  }
+
+  // The voxel storage of the allocated units (the hash map's own nodes are not counted).
+  size_t memory_bytes() const override {
+    size_t bytes = 0;
+    for (const auto& unit : volume_.volume_units_)
+      bytes += unit.second.volume_->voxels_.capacity() * sizeof(open3d::geometry::TSDFVoxel);
+    return bytes;
+  }
+
+  std::vector<Eigen::Vector3d> mesh_vertices() { return volume_.ExtractTriangleMesh()->vertices_; }
+
+ private:
+  integration::ScalableTSDFVolume volume_;
+  open3d::camera::PinholeCameraIntrinsic intrinsic_;
+  double depth_trunc_;
+  open3d::geometry::Image colour_;
+};
+
+// One (voxel, threads, mapper) cell: per-frame samples of every stage.
+struct CellResult {
+  double voxel = 0.0;
+  int threads = 0;
+  std::string mapper;
+  std::vector<std::string> stage_order;  // as the stages ran in the first frame
+  std::map<std::string, std::vector<double>> samples;
+  std::vector<double> frame_cpu_ms;  // process CPU time of the whole frame (all threads)
+  size_t peak_map_bytes = 0;
+  double frame_ratio = NAN;  // median frame / Open3D's median frame in the same cell
+  double map_ratio = NAN;    // the same for the fusion alone
+
+  double median_of(const std::string& stage) const { return median(samples.at(stage)); }
+};
+
+// Open3D's mesh against our TSDF's surface samples, integrated from the same frames.
+struct ReferenceCheck {
+  double voxel = 0.0;
+  int threads = 0;
+  size_t open3d_vertices = 0;
+  size_t tsdf_samples = 0;
+  double median_distance = NAN;  // m, Open3D vertex to the nearest TSDF sample
+  // A reference that is not where our TSDF is (wrong pose or axes) makes every ratio void.
+  bool passed() const { return open3d_vertices > 0 && median_distance < voxel; }
+};
+
+double median_nearest_distance(const std::vector<Eigen::Vector3d>& from,
+                               const std::vector<Eigen::Vector3f>& to) {
+  if (from.empty() || to.empty()) return NAN;
+  Eigen::MatrixXd points(3, static_cast<Eigen::Index>(to.size()));
+  for (size_t i = 0; i < to.size(); ++i) points.col(static_cast<Eigen::Index>(i)) = to[i].cast<double>();
+  const open3d::geometry::KDTreeFlann tree(points);
+  std::vector<double> distances;
+  distances.reserve(from.size());
+  std::vector<int> index;
+  std::vector<double> distance2;
+  for (const Eigen::Vector3d& p : from)
+    if (tree.SearchKNN(p, 1, index, distance2) == 1) distances.push_back(std::sqrt(distance2[0]));
+  return distances.empty() ? NAN : median(std::move(distances));
+}
+
+// The OpenMP runtime reads OMP_WAIT_POLICY once, when it loads: record what it was.
+const char* omp_wait_policy() { return std::getenv("OMP_WAIT_POLICY"); }
+
+double process_peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports KiB
+}
+
+void check_options(const BenchMapOptions& o) {
+  if (o.frames < 1) throw InputError("--frames must be at least 1, got " + std::to_string(o.frames));
+  if (o.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(o.every));
+  if (o.voxels.empty() || o.threads.empty() || o.mappers.empty())
+    throw InputError("--voxels, --threads-list and --mappers each need at least one value");
+  for (double v : o.voxels)
+    if (!(v > 0.0) || !std::isfinite(v))
+      throw InputError(fmt::format("--voxels: a voxel size must be a positive length in metres, got {}", v));
+  for (int t : o.threads)
+    if (t < 1) throw InputError(fmt::format("--threads-list: a thread count must be at least 1, got {}", t));
+  for (const std::string& m : o.mappers) {
+    const auto names = mapper_names();
+    if (m != kOpen3d && std::find(names.begin(), names.end(), m) == names.end()) {
+      std::string known;
+      for (const auto& n : names) known += n + ", ";
+      throw InputError("--mappers " + m + ": unknown mapper (known: " + known + kOpen3d + ")");
+    }
+  }
+  if (!o.json.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(o.json).parent_path();
+    if (!parent.empty() && !std::filesystem::is_directory(parent))
+      throw InputError("--json " + o.json + ": the directory " + parent.string() + " does not exist");
+  }
+}
+
+// Frames 0, every, 2 every, ... (at most `frames` of them), rendered once: never timed.
+std::vector<Frame> render_frames(const sim::Scenario& scenario, const BenchMapOptions& o,
+                                 Progress& progress, long& done) {
+  sim::Simulation simulation(scenario);
+  std::vector<Frame> frames;
+  for (long i = 0; i < o.frames && i * o.every < simulation.frame_count(); ++i) {
+    frames.push_back(simulation.render(static_cast<int>(i * o.every)));
+    progress.update(++done);
+  }
+  return frames;
+}
+
+CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scenario, double voxel,
+                     int threads, const std::string& mapper, Progress& progress, long& done,
+                     std::optional<ReferenceCheck>& check,
+                     std::vector<Eigen::Vector3f>& tsdf_surface,
+                     std::vector<Eigen::Vector3d>& open3d_vertices) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
+  // Open3D's own OpenMP loops: their num_threads() clause follows omp_get_max_threads() only
+  // when OMP_NUM_THREADS is set (otherwise they take every core), so set both.
+  setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+  omp_set_num_threads(threads);
+  CellResult cell;
+  cell.voxel = voxel;
+  cell.threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  cell.mapper = mapper;
+
+  std::unique_ptr<BenchedMap> map;
+  if (mapper == kOpen3d)
+    map = std::make_unique<Open3dMap>(voxel, scenario.camera);
+  else
+    map = std::make_unique<OurMap>(make_mapper(mapper, voxel, {}), scenario.ground_z);
+
+  StageList stages;
+  for (const Frame& frame : frames) {
+    stages.clear();
+    const double cpu_start = process_cpu_ms();
+    try {
+      map->process(frame, stages);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
+    }
+    cell.frame_cpu_ms.push_back(process_cpu_ms() - cpu_start);
+    for (const auto& [name, ms] : stages) {
+      if (!cell.samples.count(name)) cell.stage_order.push_back(name);
+      cell.samples[name].push_back(ms);
+    }
+    cell.peak_map_bytes = std::max(cell.peak_map_bytes, map->memory_bytes());
+    progress.update(++done);
+  }
+
+  // The reference check: Open3D's surface must be where our TSDF's is (same frames, same cell).
+  if (mapper == "tsdf") {
+    // Everything the camera reached: within its range of any camera position (the surface
+    // query's cost grows with the area of the radius, so no "infinite" radius).
+    tsdf_surface.clear();
+    const Eigen::Vector3d centre = frames.front().world_T_camera.translation();
+    double reach = 0.0;
+    for (const Frame& f : frames) reach = std::max(reach, (f.world_T_camera.translation() - centre).norm());
+    static_cast<const OurMap&>(*map).mapper().surface_points(
+        centre, reach + scenario.camera.max_range + 1.0, tsdf_surface);
+  } else if (mapper == kOpen3d) {
+    open3d_vertices = static_cast<Open3dMap&>(*map).mesh_vertices();
+  }
+  if ((mapper == "tsdf" || mapper == kOpen3d) && !tsdf_surface.empty() && !open3d_vertices.empty()) {
+    check = ReferenceCheck{voxel, cell.threads, open3d_vertices.size(), tsdf_surface.size(),
+                           median_nearest_distance(open3d_vertices, tsdf_surface)};
+  }
+  return cell;
+}
+
+std::string stage_summary(const CellResult& cell) {
+  std::string text;
+  for (const std::string& name : cell.stage_order)
+    if (name != "map" && name != "frame" && name != "raster")
+      text += fmt::format("{}{} {:.2f}", text.empty() ? "" : ", ", name, cell.median_of(name));
+  return text;
+}
+
+void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const std::vector<Frame>& frames,
+                const std::vector<CellResult>& results, const std::vector<ReferenceCheck>& checks,
+                double rss_peak_mb, double rss_frames_mb) {
+  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  json out{{"scenario", {{"name", scenario.name}, {"file", o.scenario}}},
+           {"code_version", code_version()},
+           {"frames", json::array()},
+           {"every", o.every},
+           {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
+           {"open3d", {{"class", "ScalableTSDFVolume"},
+                       {"sdf_trunc_voxels", kOpen3dTruncationVoxels},
+                       {"depth_trunc_m", scenario.camera.max_range},
+                       {"omp_wait_policy",
+                        omp_wait_policy() ? omp_wait_policy() : "unset (libgomp: spin, then sleep)"},
+                       {"timed", "depth image copy + RGBDImage::CreateFromColorAndDepth + Integrate"}}},
+           {"results", json::array()},
+           {"open3d_checks", json::array()},
+           {"peak_rss_mb", rss_peak_mb},
+           {"rss_after_rendering_mb", rss_frames_mb}};
+  for (const Frame& f : frames) out["frames"].push_back(f.index);
+  for (const CellResult& c : results) {
+    json stages = json::object();
+    for (const std::string& name : c.stage_order) stages[name] = c.median_of(name);
+    out["results"].push_back({{"voxel", c.voxel},
+                              {"threads", c.threads},
+                              {"mapper", c.mapper},
+                              {"frames", c.samples.at("frame").size()},
+                              {"median_ms", stages},
+                              {"frame_cpu_median_ms", median(c.frame_cpu_ms)},
+                              {"frame_ratio_to_open3d", number(c.frame_ratio)},
+                              {"map_ratio_to_open3d", number(c.map_ratio)},
+                              {"peak_map_bytes", c.peak_map_bytes}});
+  }
+  for (const ReferenceCheck& c : checks)
+    out["open3d_checks"].push_back({{"voxel", c.voxel},
+                                    {"threads", c.threads},
+                                    {"open3d_vertices", c.open3d_vertices},
+                                    {"tsdf_samples", c.tsdf_samples},
+                                    {"median_distance_m", number(c.median_distance)}});
+  write_text_file(o.json, out.dump(2) + "\n");
+}
+
+void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
+  check_options(o);
+  const sim::Scenario scenario = load_scenario(o.scenario);
+  try {
+    sim::validate(scenario);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(o.scenario + ": " + e.what());
+  }
+  const long available = std::min<long>(o.frames, (scenario.frames - 1) / o.every + 1);
+  const long cells = static_cast<long>(o.voxels.size() * o.threads.size() * o.mappers.size());
+  Progress progress("bench map", available * (1 + cells), global.quiet);
+  long done = 0;
+  const std::vector<Frame> frames = render_frames(scenario, o, progress, done);
+  const double rss_frames_mb = process_peak_rss_mb();
+
+  std::vector<CellResult> results;
+  std::vector<ReferenceCheck> checks;
+  for (double voxel : o.voxels)
+    for (int threads : o.threads) {
+      std::vector<Eigen::Vector3f> tsdf_surface;
+      std::vector<Eigen::Vector3d> open3d_vertices;
+      std::optional<ReferenceCheck> check;
+      for (const std::string& mapper : o.mappers)
+        results.push_back(time_cell(frames, scenario, voxel, threads, mapper, progress, done, check,
+                                    tsdf_surface, open3d_vertices));
+      if (check) checks.push_back(*check);
+    }
+  progress.finish();
+  const double rss_peak_mb = process_peak_rss_mb();
+
+  // The reference of a cell: Open3D at the same voxel size and thread count.
+  for (CellResult& cell : results)
+    for (const CellResult& ref : results)
+      if (ref.mapper == kOpen3d && ref.voxel == cell.voxel && ref.threads == cell.threads) {
+        cell.frame_ratio = cell.median_of("frame") / ref.median_of("frame");
+        cell.map_ratio = cell.median_of("map") / ref.median_of("map");
+      }
+
+  fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), medians per frame in ms\n",
+             scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every);
+  fmt::print("map = the mapper's integrate (open3d: depth copy + RGBDImage + Integrate, truncation "
+             "{:g} voxels); raster = circle + cylinder\nfrom the map's surface samples (as `run`); "
+             "frame = map + raster; cpu = process CPU time of the frame (all threads);\n"
+             "frame/o3d, map/o3d = ratios of the medians to open3d's in the same (voxel, threads) "
+             "cell.\n",
+             kOpen3dTruncationVoxels);
+  const auto ms = [](double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : std::string("-"); };
+  fmt::print("{:>6} {:>3} {:<10} {:>6} | {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9} | {}\n", "voxel",
+             "thr", "mapper", "frames", "frame", "cpu", "map", "raster", "frame/o3d", "map/o3d",
+             "peak MB", "stages");
+  for (const CellResult& c : results)
+    fmt::print("{:>6.2f} {:>3} {:<10} {:>6} | {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9.1f} | {}\n",
+               c.voxel, c.threads, c.mapper, c.samples.at("frame").size(), ms(c.median_of("frame")),
+               ms(median(c.frame_cpu_ms)), ms(c.median_of("map")),
+               ms(c.samples.count("raster") ? c.median_of("raster") : NAN), ms(c.frame_ratio),
+               ms(c.map_ratio), c.peak_map_bytes / 1048576.0, stage_summary(c));
+  for (const ReferenceCheck& c : checks)
+    fmt::print("open3d check, voxel {:.2f}, {} threads: {} mesh vertices, median distance to the "
+               "TSDF's {} surface samples {:.4f} m ({:.2f} voxels): {}\n",
+               c.voxel, c.threads, c.open3d_vertices, c.tsdf_samples, c.median_distance,
+               c.median_distance / c.voxel, c.passed() ? "ok" : "FAILED");
+  fmt::print("peak RSS: {:.1f} MB for the whole run ({:.1f} MB after rendering the frames)\n",
+             rss_peak_mb, rss_frames_mb);
+  if (!omp_wait_policy() && std::any_of(o.threads.begin(), o.threads.end(), [](int t) { return t > 1; }))
+    fmt::print("note: OMP_WAIT_POLICY is unset, so Open3D's OpenMP threads spin before they "
+               "sleep: on a busy machine\nits multi-thread times are mostly spinning "
+               "(OMP_WAIT_POLICY=PASSIVE measures a shared machine).\n");
+
+  const bool reference_ok =
+      std::all_of(checks.begin(), checks.end(), [](const ReferenceCheck& c) { return c.passed(); });
+  if (!o.json.empty()) write_json(o, scenario, frames, results, checks, rss_peak_mb, rss_frames_mb);
+  if (!reference_ok)
+    throw std::runtime_error("bench map: the Open3D reference failed its check (its surface is not "
+                             "within a voxel of our TSDF's): the ratios are not valid");
+}
+
+}  // namespace
+
+void add_bench_map(CLI::App& bench, const GlobalOptions& global) {
+  auto options = std::make_shared<BenchMapOptions>();
+  CLI::App* cmd = bench.add_subcommand(
+      "map", "Mapping speed: median ms per frame of each stage (and the rasters) per voxel size,\n"
+             "thread count and mapper, against Open3D's ScalableTSDFVolume on the same frames");
+  cmd->add_option("scenario", options->scenario, "Scenario YAML")->capture_default_str();
+  cmd->add_option("--frames", options->frames, "Frames to integrate and time")->capture_default_str();
+  cmd->add_option("--every", options->every, "Take every K-th frame of the scenario (from frame 0)")
+      ->capture_default_str();
+  cmd->add_option("--voxels", options->voxels, "Voxel sizes in metres")
+      ->delimiter(',')->capture_default_str();
+  cmd->add_option("--threads-list", options->threads, "Thread counts (TBB and Open3D's OpenMP)")
+      ->delimiter(',')->capture_default_str();
+  cmd->add_option("--mappers", options->mappers, "Mappers: vdb_gpdf, tsdf, depth_only, open3d")
+      ->delimiter(',')->capture_default_str();
+  cmd->add_option("--json", options->json, "Write the results as JSON (atomically)");
+  cmd->callback([options, &global] { bench_map(*options, global); });
+}
+
+}  // namespace sonomap::harness

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/app/frame_source.hpp"
+
+#include "harness/formats/scenario_yaml.hpp"
+#include "harness/formats/tum_io.hpp"
+#include "harness/support/errors.hpp"
+#include "sim/simulation.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace sonomap::harness {
+namespace {
+
+class SimulatedSource final : public FrameSource {
+ public:
+  SimulatedSource(sim::Scenario scenario, const fs::path& file) : scenario_(std::move(scenario)) {
+    try {
+      simulation_ = std::make_unique<sim::Simulation>(scenario_);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file.string() + ": " + e.what());
+    }
+  }
+  std::string name() const override { return scenario_.name; }
+  int frame_count() const override { return simulation_->frame_count(); }
+  Frame frame(int i) override { return simulation_->render(i); }
+  double ground_z() const override { return scenario_.ground_z; }
+  std::uint64_t seed() const override { return scenario_.seed; }
+  std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
+    return sim::world_triangles(scenario_, t);
+  }
+
+ private:
+  sim::Scenario scenario_;
+  std::unique_ptr<sim::Simulation> simulation_;
+};
+
+// A recorded sequence (depth.txt, groundtruth.txt, depth/*.png, camera.yaml): its poses are
+// what a localisation system gave; the ground is the world's z = 0 plane (as TUM's and ours).
+class RecordedSource final : public FrameSource {
+ public:
+  RecordedSource(const fs::path& dir, int frames) : sequence_(read_tum_sequence(dir)) {
+    if (sequence_.frames.empty()) throw InputError(dir.string() + ": the sequence has no frame with a pose");
+    count_ = static_cast<int>(sequence_.frames.size());
+    if (frames > 0) count_ = std::min(count_, frames);
+  }
+  std::string name() const override {
+    return sequence_.camera.name.empty() ? sequence_.dir.filename().string() : sequence_.camera.name;
+  }
+  int frame_count() const override { return count_; }
+  Frame frame(int i) override { return load_tum_frame(sequence_, static_cast<std::size_t>(i)); }
+  double ground_z() const override { return 0.0; }
+  std::uint64_t seed() const override { return 0; }
+  std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }
+
+ private:
+  TumSequence sequence_;
+  int count_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> open_frame_source(const fs::path& input,
+                                               std::vector<std::string> overrides, int frames,
+                                               std::optional<std::uint64_t> seed) {
+  if (fs::is_directory(input)) {
+    if (!overrides.empty())
+      throw InputError("--set " + overrides.front() +
+                       ": a recorded sequence has no scenario keys (only run keys apply)");
+    return std::make_unique<RecordedSource>(input, frames);
+  }
+  if (frames > 0) overrides.push_back("frames=" + std::to_string(frames));
+  if (seed) overrides.push_back("seed=" + std::to_string(*seed));
+  return std::make_unique<SimulatedSource>(load_scenario(input, overrides), input);
+}
+
+}  // namespace sonomap::harness

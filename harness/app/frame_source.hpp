@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Where a run's frames come from: the simulator (with exact ground truth) or a recorded
+// sequence (no ground truth). The run loop sees only FrameSource.
+#pragma once
+
+#include "core/types.hpp"
+#include "sim/world_geometry.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sonomap::harness {
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual std::string name() const = 0;
+  virtual int frame_count() const = 0;
+  virtual Frame frame(int i) = 0;
+  virtual double ground_z() const = 0;
+  virtual std::uint64_t seed() const = 0;
+  // World triangles at time t, or nullopt when there is no ground truth (recorded data).
+  virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
+};
+
+// The frame source a run's input names: a directory is a recorded TUM RGB-D sequence (its
+// first `frames` frames; 0: all), anything else a scenario YAML file loaded with `overrides`
+// (its frame count set by `frames` > 0 and its seed by `seed`).
+std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& input,
+                                               std::vector<std::string> overrides, int frames,
+                                               std::optional<std::uint64_t> seed);
+
+}  // namespace sonomap::harness

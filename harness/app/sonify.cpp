@@ -1,0 +1,216 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/app/sonify.hpp"
+
+#include "harness/formats/sofa_io.hpp"
+#include "harness/formats/wav_io.hpp"
+#include "harness/support/errors.hpp"
+#include "harness/support/output.hpp"
+#include "harness/support/progress.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <tbb/parallel_for.h>
+
+namespace fs = std::filesystem;
+
+namespace sonomap::harness {
+
+fs::path default_hrir_file() { return "/usr/share/libmysofa/default.sofa"; }
+
+void add_room_options(CLI::App& cmd, RoomOptions& o) {
+  cmd.add_option("--room", o.room, "Shoebox room LxWxH in metres (corner at the origin)")
+      ->capture_default_str();
+  cmd.add_option("--room-min", o.room_min, "Room corner x,y,z (with --room-max; e.g. a map's box)")
+      ->delimiter(',')->expected(3);
+  cmd.add_option("--room-max", o.room_max, "Opposite room corner x,y,z")->delimiter(',')->expected(3);
+  cmd.add_option("--listener", o.listener, "Head position x,y,z (default: room centre, 1.5 m high)")
+      ->delimiter(',')->expected(3);
+  cmd.add_option("--heading", o.heading_deg, "Direction the listener faces, degrees from +x")
+      ->capture_default_str();
+  cmd.add_option("--rt60", o.rt60, "Reverberation time, seconds")->capture_default_str();
+  cmd.add_option("--order", o.order, "Image-source reflection order")->capture_default_str();
+  cmd.add_option("--ir-length", o.length_s, "BRIR length, seconds (0: the RT60)")
+      ->capture_default_str();
+  cmd.add_option("--seed", o.seed, "Seed of the late-tail noise")->capture_default_str();
+  cmd.add_option("--hrir", o.hrir_file, "HRIR set (SOFA) the BRIRs are built from")
+      ->capture_default_str();
+}
+
+static double parse_number(const std::string& text, const std::string& option) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(v))
+    throw InputError("option " + option + ": not a number: '" + text + "'");
+  return v;
+}
+
+audio::BrirSynthConfig room_config(const RoomOptions& o, double sample_rate) {
+  audio::BrirSynthConfig c;
+  if (!o.room_min.empty() || !o.room_max.empty()) {
+    if (o.room_min.size() != 3 || o.room_max.size() != 3)
+      throw InputError("options --room-min/--room-max: give both, as x,y,z");
+    c.room.min_corner = Eigen::Vector3d(o.room_min[0], o.room_min[1], o.room_min[2]);
+    c.room.max_corner = Eigen::Vector3d(o.room_max[0], o.room_max[1], o.room_max[2]);
+  } else {
+    std::vector<double> dims;
+    std::stringstream in(o.room);
+    std::string part;
+    while (std::getline(in, part, 'x')) dims.push_back(parse_number(part, "--room"));
+    if (dims.size() != 3)
+      throw InputError("option --room: expected LxWxH (e.g. 5x4x3), got '" + o.room + "'");
+    c.room.min_corner.setZero();
+    c.room.max_corner = Eigen::Vector3d(dims[0], dims[1], dims[2]);
+  }
+  if (!o.listener.empty()) {
+    if (o.listener.size() != 3) throw InputError("option --listener: expected x,y,z");
+    c.listener = Eigen::Vector3d(o.listener[0], o.listener[1], o.listener[2]);
+  }
+  c.listener_heading_deg = o.heading_deg;
+  c.rt60 = o.rt60;
+  c.max_order = o.order;
+  c.length_s = o.length_s;
+  c.seed = o.seed;
+  c.sample_rate = sample_rate;
+  try {
+    audio::validate(c);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("room options (--room, --listener, --rt60, --order, --ir-length): ") +
+                     e.what());
+  }
+  return c;
+}
+
+audio::BrirSynthConfig room_from_box(const Eigen::Vector3d& min_corner,
+                                     const Eigen::Vector3d& max_corner,
+                                     const Eigen::Vector3d& listener, double rt60) {
+  audio::BrirSynthConfig c;
+  c.room.min_corner = min_corner;
+  c.room.max_corner = max_corner;
+  c.listener = listener;
+  c.rt60 = rt60;
+  audio::validate(c);
+  return c;
+}
+
+audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::path& hrir_file,
+                                bool quiet) {
+  const audio::HrirSet hrirs = read_hrir_set(hrir_file, room.sample_rate);
+  const audio::BrirSynthesizer synth(hrirs, room);
+  const audio::BrirGrid grid = audio::BrirGrid::paper();
+  const size_t na = grid.azimuths_deg.size();
+  std::vector<audio::BinauralIr> irs(na * grid.distances_m.size());
+  Progress progress("BRIRs", static_cast<long>(irs.size()), quiet);
+  std::atomic<long> done{0};
+  // Each grid point in its own slot: the set does not depend on the thread count.
+  tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
+    irs[i] = synth.synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
+    ++done;
+  });
+  progress.update(done);
+  progress.finish();
+  return audio::BrirSet(room.sample_rate, grid, std::move(irs));
+}
+
+void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
+  cmd.add_option("--brir", s.brir_dir, "Directory of BRIR SOFA files, one per distance "
+                                       "(default: synthesise the room given by the room options)");
+  add_room_options(cmd, s.room);
+  audio::SweepConfig& w = s.sweep;
+  cmd.add_option("--mode", w.mode, "ranging (every sector) or objects (pseudo-objects)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, audio::SweepMode>{{"ranging", audio::SweepMode::Ranging},
+                                                  {"objects", audio::SweepMode::Objects}}));
+  cmd.add_option("--period", w.period_s, "Seconds per sweep (36 sectors)")->capture_default_str();
+  cmd.add_option("--sector-onsets", w.sector_onsets_s,
+                 "Onset of each sector, seconds (36 increasing values, comma separated)")
+      ->delimiter(',');
+  cmd.add_option("--scale", w.environment_scale, "Range x scale -> BRIR distance")
+      ->capture_default_str();
+  cmd.add_option("--fov-centre", w.filter.fov_centre_deg, "Field of view centre, degrees")
+      ->capture_default_str();
+  cmd.add_option("--fov-width", w.filter.fov_width_deg, "Field of view width, degrees")
+      ->capture_default_str();
+  cmd.add_option("--min-range", w.filter.min_range_m, "Play only ranges >= this, metres");
+  cmd.add_option("--max-range", w.filter.max_range_m, "Play only ranges <= this, metres");
+  cmd.add_option("--max-taps", w.filter.max_taps, "Ranging: only the N nearest taps (0: all)")
+      ->capture_default_str();
+  cmd.add_option("--max-objects", w.max_objects, "Objects: the N nearest pseudo-objects")
+      ->capture_default_str();
+  cmd.add_option("--object-jump", w.object_jump_m_per_deg,
+                 "Objects: split where the range jumps more than this, metres per degree")
+      ->capture_default_str();
+  cmd.add_option("--near-below", w.pitch.near_below_m, "Near taps: BRIR distance below, metres")
+      ->capture_default_str();
+  cmd.add_option("--near-shift", w.pitch.near_semitones, "Near taps: pitch shift, semitones")
+      ->capture_default_str();
+  cmd.add_option("--far-above", w.pitch.far_above_m, "Far taps: BRIR distance above, metres")
+      ->capture_default_str();
+  cmd.add_option("--far-shift", w.pitch.far_semitones, "Far taps: pitch shift, semitones")
+      ->capture_default_str();
+  cmd.add_flag("--invert-pitch", w.pitch.inverted, "Near higher, far lower (parking sensor)");
+  cmd.add_flag("!--no-woosh", w.woosh_unknown, "Unknown sectors stay silent");
+}
+
+void check_sweep_options(const SonifySetup& s) {
+  try {
+    s.sweep.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("sweep options: ") + e.what());
+  }
+}
+
+std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quiet) {
+  const double rate = s.sweep.sample_rate;
+  if (!s.brir_dir.empty())
+    return std::make_shared<const audio::BrirSet>(read_brir_directory(s.brir_dir, rate));
+  const audio::BrirSynthConfig room = room_config(s.room, rate);
+  if (!quiet) {
+    const Eigen::Vector3d size = room.room.size();
+    std::fprintf(stderr,
+                 "sonomap: no --brir given: synthesising BRIRs in memory for a %.1fx%.1fx%.1f m "
+                 "room, RT60 %.2f s, order %d, from %s\n",
+                 size.x(), size.y(), size.z(), room.rt60, room.max_order,
+                 s.room.hrir_file.string().c_str());
+  }
+  return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet));
+}
+
+std::string sweep_events_csv(const std::vector<audio::SweepEvent>& events) {
+  std::string out =
+      "time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,pitch_semitones,sound\n";
+  char buf[256];
+  for (const auto& e : events) {
+    char range[32] = "";
+    if (std::isfinite(e.range_m)) std::snprintf(range, sizeof range, "%.4f", e.range_m);
+    std::snprintf(buf, sizeof buf, "%.6f,%d,%.3f,%s,%.2f,%.1f,%.1f,%s\n", e.time_s, e.sector,
+                  e.azimuth_deg, range, e.brir_distance_m, e.brir_azimuth_deg, e.pitch_semitones,
+                  audio::to_string(e.sound));
+    out += buf;
+  }
+  return out;
+}
+
+fs::path events_path_for(const fs::path& wav) {
+  fs::path p = wav;
+  p.replace_extension(".events.csv");
+  return p;
+}
+
+void write_sweep(const audio::SweepAudio& audio, const fs::path& wav) {
+  StagedFile wav_file(wav);
+  StagedFile events_file(events_path_for(wav));
+  write_wav(wav_file.path(), audio.sample_rate, audio.left, audio.right);
+  {
+    std::FILE* f = std::fopen(events_file.path().c_str(), "wb");
+    if (!f) throw std::runtime_error("cannot write " + events_file.path().string());
+    const std::string text = sweep_events_csv(audio.events);
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + events_file.path().string());
+  }
+  events_file.commit();
+  wav_file.commit();
+}
+
+}  // namespace sonomap::harness

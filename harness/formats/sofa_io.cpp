@@ -1,0 +1,416 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/formats/sofa_io.hpp"
+
+#include "audio/resample.hpp"
+#include "harness/support/errors.hpp"
+#include "harness/support/output.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <map>
+#include <memory>
+#include <mysofa.h>
+#include <netcdf.h>
+
+namespace fs = std::filesystem;
+
+namespace sonomap::harness {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string mysofa_error_name(int err) {
+  switch (err) {
+    case MYSOFA_INTERNAL_ERROR: return "internal error";
+    case MYSOFA_INVALID_FORMAT: return "invalid format";
+    case MYSOFA_UNSUPPORTED_FORMAT: return "unsupported format";
+    case MYSOFA_NO_MEMORY: return "out of memory";
+    case MYSOFA_READ_ERROR: return "read error";
+    case MYSOFA_INVALID_ATTRIBUTES: return "invalid attributes (need SimpleFreeFieldHRIR, FIR)";
+    case MYSOFA_INVALID_DIMENSIONS: return "invalid dimensions";
+    case MYSOFA_INVALID_DIMENSION_LIST: return "invalid dimension list";
+    case MYSOFA_INVALID_COORDINATE_TYPE: return "invalid coordinate type";
+    case MYSOFA_ONLY_EMITTER_WITH_ECI_SUPPORTED: return "unsupported emitter layout";
+    case MYSOFA_ONLY_DELAYS_WITH_IR_OR_MR_SUPPORTED: return "unsupported delay layout";
+    case MYSOFA_ONLY_THE_SAME_SAMPLING_RATE_SUPPORTED: return "several sampling rates";
+    case MYSOFA_RECEIVERS_WITH_RCI_SUPPORTED: return "unsupported receiver layout";
+    case MYSOFA_RECEIVERS_WITH_CARTESIAN_SUPPORTED: return "receivers must be cartesian";
+    case MYSOFA_INVALID_RECEIVER_POSITIONS: return "invalid receiver positions";
+    case MYSOFA_ONLY_SOURCES_WITH_MC_SUPPORTED: return "unsupported source layout";
+    default: return "error " + std::to_string(err);
+  }
+}
+
+struct HrtfDeleter {
+  void operator()(MYSOFA_HRTF* h) const { mysofa_free(h); }
+};
+
+[[noreturn]] void bad(const fs::path& file, const std::string& what) {
+  throw InputError(file.string(), 0, "", what);
+}
+
+}  // namespace
+
+SofaContents read_sofa(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) bad(file, "not a readable file");
+  int err = 0;
+  std::unique_ptr<MYSOFA_HRTF, HrtfDeleter> hrtf(mysofa_load(file.c_str(), &err));
+  if (!hrtf || err != MYSOFA_OK) bad(file, "libmysofa cannot load it: " + mysofa_error_name(err));
+  err = mysofa_check(hrtf.get());
+  if (err != MYSOFA_OK) bad(file, "not a usable SOFA HRIR/BRIR file: " + mysofa_error_name(err));
+  mysofa_tocartesian(hrtf.get());
+
+  const MYSOFA_HRTF& h = *hrtf;
+  const size_t m = h.M, r = h.R, n = h.N;
+  if (m == 0 || r != 2 || n == 0) bad(file, "needs M > 0 measurements, 2 receivers, N > 0 samples");
+  if (!h.DataIR.values || h.DataIR.elements != m * r * n)
+    bad(file, "Data.IR holds " + std::to_string(h.DataIR.elements) + " values, expected M*R*N = " +
+                  std::to_string(m * r * n));
+  if (!h.SourcePosition.values || h.SourcePosition.elements != m * 3)
+    bad(file, "SourcePosition must hold M x 3 values");
+  if (!h.DataSamplingRate.values || h.DataSamplingRate.elements < 1)
+    bad(file, "Data.SamplingRate is missing");
+  const double rate = h.DataSamplingRate.values[0];
+  if (!std::isfinite(rate) || rate < 8000.0 || rate > 384000.0)
+    bad(file, "Data.SamplingRate " + std::to_string(rate) + " Hz is outside [8000, 384000]");
+
+  // Data.Delay (dims I,R or M,R) in samples: applied as whole samples in front of the IR.
+  std::vector<size_t> delay(m * 2, 0);
+  if (h.DataDelay.values) {
+    const size_t e = h.DataDelay.elements;
+    if (e != 2 && e != m * 2) bad(file, "Data.Delay must hold R or M x R values");
+    for (size_t i = 0; i < m * 2; ++i) {
+      const double d = h.DataDelay.values[e == 2 ? i % 2 : i];
+      if (!std::isfinite(d) || d < 0.0 || d > rate) bad(file, "Data.Delay out of [0, 1 s]");
+      delay[i] = static_cast<size_t>(std::lround(d));
+    }
+  }
+  const size_t longest = n + *std::max_element(delay.begin(), delay.end());
+
+  SofaContents out;
+  out.sample_rate = rate;
+  if (const char* room = mysofa_getAttribute(h.attributes, const_cast<char*>("RoomType")))
+    out.room_type = room;
+  out.source_positions.reserve(m);
+  out.irs.reserve(m);
+  for (size_t i = 0; i < m; ++i) {
+    const float* p = h.SourcePosition.values + 3 * i;
+    out.source_positions.emplace_back(p[0], p[1], p[2]);
+    if (!out.source_positions.back().allFinite())
+      bad(file, "SourcePosition of measurement " + std::to_string(i) + " is not finite");
+    audio::BinauralIr ir{std::vector<float>(longest, 0.0f), std::vector<float>(longest, 0.0f)};
+    for (size_t ear = 0; ear < 2; ++ear) {
+      const float* src = h.DataIR.values + (i * r + ear) * n;
+      auto& dst = ear == 0 ? ir.left : ir.right;
+      for (size_t k = 0; k < n; ++k) {
+        if (!std::isfinite(src[k]))
+          bad(file, "Data.IR of measurement " + std::to_string(i) + " is not finite");
+        dst[delay[2 * i + ear] + k] = src[k];
+      }
+    }
+    out.irs.push_back(std::move(ir));
+  }
+  return out;
+}
+
+static audio::BinauralIr resampled(const audio::BinauralIr& ir, double ratio) {
+  if (ratio == 1.0) return ir;
+  audio::BinauralIr out{audio::resample(ir.left, ratio), audio::resample(ir.right, ratio)};
+  const size_t n = std::max(out.left.size(), out.right.size());
+  out.left.resize(n, 0.0f);
+  out.right.resize(n, 0.0f);
+  return out;
+}
+
+audio::HrirSet read_hrir_set(const fs::path& file, double output_rate) {
+  SofaContents sofa = read_sofa(file);
+  audio::HrirSet set;
+  set.sample_rate = output_rate;
+  const double ratio = output_rate / sofa.sample_rate;
+  for (size_t i = 0; i < sofa.irs.size(); ++i) {
+    if (sofa.source_positions[i].norm() < 1e-9) bad(file, "a source sits at the listener");
+    set.directions.push_back(sofa.source_positions[i].normalized());
+    set.irs.push_back(resampled(sofa.irs[i], ratio));
+  }
+  try {
+    set.validate();
+  } catch (const std::invalid_argument& e) {
+    bad(file, e.what());
+  }
+  return set;
+}
+
+audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate,
+                                   const std::vector<double>& required) {
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) bad(directory, "not a directory");
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(directory, ec))
+    if (entry.path().extension() == ".sofa") files.push_back(entry.path());
+  if (ec) bad(directory, "cannot list: " + ec.message());
+  if (files.empty()) bad(directory, "no .sofa files (expected one BRIR file per distance)");
+  std::sort(files.begin(), files.end());
+
+  struct Layer {
+    double distance;
+    std::vector<audio::BinauralIr> irs;  // in the order of `azimuths`
+  };
+  std::vector<double> azimuths;  // from the first file
+  std::vector<Layer> layers;
+  double rate = 0.0;
+  fs::path rate_file;
+  size_t length = 0;
+  for (const fs::path& file : files) {
+    SofaContents sofa = read_sofa(file);
+    if (rate == 0.0) {
+      rate = sofa.sample_rate;
+      rate_file = file;
+    } else if (std::abs(sofa.sample_rate - rate) > 1e-6) {
+      bad(file, "sample rate " + std::to_string(sofa.sample_rate) + " Hz differs from " +
+                    std::to_string(rate) + " Hz of " + rate_file.filename().string());
+    }
+    Layer layer{-1.0, {}};
+    std::vector<double> file_azimuths;
+    for (size_t i = 0; i < sofa.irs.size(); ++i) {
+      const Eigen::Vector3d& p = sofa.source_positions[i];
+      const double horizontal = p.head<2>().norm();
+      const double elevation = std::atan2(p.z(), horizontal) * 180.0 / kPi;
+      if (std::abs(elevation) >= 1.0) continue;
+      const double distance = p.norm();
+      if (layer.distance < 0.0) layer.distance = distance;
+      if (std::abs(distance - layer.distance) > 0.01)
+        bad(file, "holds several distances (" + std::to_string(layer.distance) + " and " +
+                      std::to_string(distance) + " m); write one file per distance");
+      file_azimuths.push_back(std::atan2(p.y(), p.x()) * 180.0 / kPi);
+      layer.irs.push_back(sofa.irs[i]);
+    }
+    if (layer.irs.empty()) bad(file, "no measurement on the horizontal plane");
+    if (azimuths.empty()) {
+      azimuths = file_azimuths;
+    } else {
+      // Same azimuths as the first file, reordered to its order.
+      if (file_azimuths.size() != azimuths.size())
+        bad(file, std::to_string(file_azimuths.size()) + " horizontal azimuths, the first file has " +
+                      std::to_string(azimuths.size()));
+      std::vector<audio::BinauralIr> ordered;
+      for (double a : azimuths) {
+        size_t j = 0;
+        while (j < file_azimuths.size() &&
+               std::abs(audio::wrap_degrees_180(file_azimuths[j] - a)) > 0.01)
+          ++j;
+        if (j == file_azimuths.size())
+          bad(file, "has no measurement at azimuth " + std::to_string(a) + " degrees");
+        ordered.push_back(std::move(layer.irs[j]));
+      }
+      layer.irs = std::move(ordered);
+    }
+    for (const auto& other : layers)
+      if (std::abs(other.distance - layer.distance) < 0.01)
+        bad(file, "a second file for distance " + std::to_string(layer.distance) + " m");
+    length = std::max(length, layer.irs.front().left.size());
+    layers.push_back(std::move(layer));
+  }
+  for (double d : required) {
+    const bool found = std::any_of(layers.begin(), layers.end(),
+                                   [&](const Layer& l) { return std::abs(l.distance - d) < 0.01; });
+    if (!found) {
+      std::string have;
+      for (const auto& l : layers) have += (have.empty() ? "" : ", ") + std::to_string(l.distance);
+      bad(directory, "missing BRIRs for distance " + std::to_string(d) + " m (have: " + have + ")");
+    }
+  }
+  std::sort(layers.begin(), layers.end(),
+            [](const Layer& a, const Layer& b) { return a.distance < b.distance; });
+  audio::BrirGrid grid;
+  grid.azimuths_deg = azimuths;
+  std::vector<audio::BinauralIr> irs;
+  const double ratio = output_rate / rate;
+  for (auto& layer : layers) {
+    grid.distances_m.push_back(layer.distance);
+    for (auto& ir : layer.irs) {
+      ir.left.resize(length, 0.0f);  // files of different lengths: pad with silence
+      ir.right.resize(length, 0.0f);
+      irs.push_back(resampled(ir, ratio));
+    }
+  }
+  try {
+    return audio::BrirSet(output_rate, std::move(grid), std::move(irs));
+  } catch (const std::invalid_argument& e) {
+    bad(directory, e.what());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing (netCDF-4)
+
+namespace {
+
+class NetcdfFile {
+ public:
+  explicit NetcdfFile(const fs::path& path) : path_(path) {
+    check(nc_create(path.c_str(), NC_NETCDF4 | NC_CLOBBER, &id_), "create");
+  }
+  ~NetcdfFile() {
+    if (id_ >= 0) nc_close(id_);
+  }
+  void check(int status, const std::string& what) const {
+    if (status != NC_NOERR)
+      throw std::runtime_error(path_.string() + ": netCDF " + what + ": " + nc_strerror(status));
+  }
+  int id() const { return id_; }
+  int dim(const char* name, size_t length) {
+    int d = -1;
+    check(nc_def_dim(id_, name, length, &d), std::string("dimension ") + name);
+    return d;
+  }
+  void text(int var, const char* name, const std::string& value) {
+    check(nc_put_att_text(id_, var, name, value.size(), value.c_str()), std::string("attribute ") + name);
+  }
+  int variable(const char* name, std::initializer_list<int> dims) {
+    int v = -1;
+    std::vector<int> d(dims);
+    check(nc_def_var(id_, name, NC_DOUBLE, static_cast<int>(d.size()), d.data(), &v),
+          std::string("variable ") + name);
+    check(nc_def_var_chunking(id_, v, NC_CONTIGUOUS, nullptr), std::string("layout of ") + name);
+    return v;
+  }
+  void put(int var, const std::vector<double>& values) {
+    check(nc_put_var_double(id_, var, values.data()), "write data");
+  }
+  void close() {
+    const int id = id_;
+    id_ = -1;
+    check(nc_close(id), "close");
+  }
+
+ private:
+  fs::path path_;
+  int id_ = -1;
+};
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", &tm);
+  return buf;
+}
+
+}  // namespace
+
+std::string brir_file_name(double distance_m) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "brir_%.2fm.sofa", distance_m);
+  return buf;
+}
+
+static void write_sofa_file(const fs::path& path, double sample_rate, double distance_m,
+                            const std::vector<double>& azimuths,
+                            const std::vector<audio::BinauralIr>& irs, const SofaMetadata& meta) {
+  if (azimuths.empty() || azimuths.size() != irs.size())
+    throw std::invalid_argument("write SOFA: need one IR per azimuth");
+  const size_t m = irs.size(), n = irs.front().left.size();
+  for (const auto& ir : irs)
+    if (ir.left.size() != n || ir.right.size() != n || n == 0)
+      throw std::invalid_argument("write SOFA: IRs of different lengths");
+  NetcdfFile f(path);
+  const std::string now = utc_now();
+  const std::pair<const char*, std::string> globals[] = {
+      {"Conventions", "SOFA"},
+      {"Version", "1.0"},
+      {"SOFAConventions", "SimpleFreeFieldHRIR"},
+      {"SOFAConventionsVersion", "1.0"},
+      {"APIName", "sonomap"},
+      {"APIVersion", "0.1"},
+      {"ApplicationName", "sonomap brir"},
+      {"ApplicationVersion", "0.1"},
+      {"AuthorContact", ""},
+      {"Organization", ""},
+      {"License", "GPL-3.0-or-later"},
+      {"DataType", "FIR"},
+      {"RoomType", meta.room_type},
+      {"Title", meta.title},
+      {"Comment", meta.comment},
+      {"DateCreated", now},
+      {"DateModified", now},
+      {"ListenerShortName", "KEMAR"},
+      {"DatabaseName", "sonomap"},
+      {"History", "synthesised by the image-source method"},
+      {"References", "Allen and Berkley 1979"},
+      {"Origin", "synthetic"}};
+  for (const auto& [name, value] : globals) f.text(NC_GLOBAL, name, value);
+
+  const int I = f.dim("I", 1), C = f.dim("C", 3), R = f.dim("R", 2), E = f.dim("E", 1);
+  const int N = f.dim("N", n), M = f.dim("M", m);
+  const int listener = f.variable("ListenerPosition", {I, C});
+  f.text(listener, "Type", "cartesian");
+  f.text(listener, "Units", "metre");
+  const int up = f.variable("ListenerUp", {I, C});
+  f.text(up, "Type", "cartesian");
+  f.text(up, "Units", "metre");
+  const int view = f.variable("ListenerView", {I, C});
+  f.text(view, "Type", "cartesian");
+  f.text(view, "Units", "metre");
+  const int receiver = f.variable("ReceiverPosition", {R, C, I});
+  f.text(receiver, "Type", "cartesian");
+  f.text(receiver, "Units", "metre");
+  const int source = f.variable("SourcePosition", {M, C});
+  f.text(source, "Type", "spherical");
+  f.text(source, "Units", "degree, degree, metre");
+  const int emitter = f.variable("EmitterPosition", {E, C, I});
+  f.text(emitter, "Type", "cartesian");
+  f.text(emitter, "Units", "metre");
+  const int ir = f.variable("Data.IR", {M, R, N});
+  const int rate = f.variable("Data.SamplingRate", {I});
+  f.text(rate, "Units", "hertz");
+  const int delay = f.variable("Data.Delay", {I, R});
+  f.check(nc_enddef(f.id()), "end of definitions");
+
+  f.put(listener, {0, 0, 0});
+  f.put(up, {0, 0, 1});
+  f.put(view, {1, 0, 0});
+  f.put(receiver, {0, 0.09, 0, 0, -0.09, 0});  // left ear +y, right ear -y
+  std::vector<double> positions;
+  for (double a : azimuths) positions.insert(positions.end(), {a, 0.0, distance_m});
+  f.put(source, positions);
+  f.put(emitter, {0, 0, 0});
+  std::vector<double> data;
+  data.reserve(m * 2 * n);
+  for (const auto& pair : irs) {
+    data.insert(data.end(), pair.left.begin(), pair.left.end());
+    data.insert(data.end(), pair.right.begin(), pair.right.end());
+  }
+  f.put(ir, data);
+  f.put(rate, {sample_rate});
+  f.put(delay, {0, 0});
+  f.close();
+}
+
+void write_brir_sofa(const fs::path& file, double sample_rate, double distance_m,
+                     const std::vector<double>& azimuths_deg,
+                     const std::vector<audio::BinauralIr>& irs, const SofaMetadata& meta) {
+  StagedFile staged(file);
+  write_sofa_file(staged.path(), sample_rate, distance_m, azimuths_deg, irs, meta);
+  staged.commit();
+}
+
+void write_brir_directory(const fs::path& directory, const audio::BrirSet& set,
+                          const SofaMetadata& meta) {
+  StagedDirectory staged(directory, true);
+  const size_t na = set.azimuth_count();
+  for (size_t d = 0; d < set.distance_count(); ++d) {
+    std::vector<audio::BinauralIr> irs;
+    for (size_t a = 0; a < na; ++a) irs.push_back(set.at(d, a));
+    const double distance = set.grid().distances_m[d];
+    write_sofa_file(staged.path() / brir_file_name(distance), set.sample_rate(), distance,
+                    set.grid().azimuths_deg, irs, meta);
+  }
+  staged.commit();
+}
+
+}  // namespace sonomap::harness

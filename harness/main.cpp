@@ -1,4 +1,0 @@
-// SPDX-License-Identifier: GPL-3.0-or-later
-#include "harness/cli.hpp"
-
-int main(int argc, char** argv) { return sonomap::harness::run_cli(argc, argv); }

@@ -1,0 +1,285 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "harness/report/claims.hpp"
+#include "harness/report/report.hpp"
+
+#include "harness/report/pictures.hpp"
+#include "harness/support/errors.hpp"
+#include "harness/support/output.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace sonomap::harness {
+namespace {
+
+struct RunRecord {
+  std::string id;
+  fs::path dir;
+  json summary;
+  json timings;
+  std::string scenario, variant, mapper;
+  double voxel = NAN;
+  std::uint64_t seed = 0;
+};
+
+std::string tag(const json& summary, const char* key, const std::string& fallback) {
+  const json& tags = summary.value("tags", json::object());
+  return tags.contains(key) ? tags[key].get<std::string>() : fallback;
+}
+
+std::vector<RunRecord> read_runs(const fs::path& dir) {
+  std::vector<RunRecord> runs;
+  const fs::path runs_dir = dir / "runs";
+  if (!fs::is_directory(runs_dir)) return runs;
+  for (const auto& entry : fs::directory_iterator(runs_dir)) {
+    const fs::path summary_path = entry.path() / "summary.json";
+    if (!entry.is_directory() || !fs::is_regular_file(summary_path)) continue;
+    RunRecord r;
+    r.id = entry.path().filename().string();
+    r.dir = entry.path();
+    try {
+      std::ifstream in(summary_path);
+      r.summary = json::parse(in);
+      std::ifstream tin(entry.path() / "timings.json");
+      r.timings = tin ? json::parse(tin) : json::object();
+    } catch (const json::exception& e) {
+      throw InputError(summary_path.string() + ": not a sonomap summary: " + e.what());
+    }
+    const json& config = r.summary["config"];
+    r.mapper = config.value("mapper", "?");
+    r.scenario = tag(r.summary, "scenario", r.summary["scenario"].value("name", "?"));
+    r.variant = tag(r.summary, "variant", r.mapper);
+    r.seed = r.summary.value("seed", std::uint64_t{0});
+    const json& mc = config.value("mapper_config", json::object());
+    for (const char* key : {"global_voxel", "voxel"})
+      if (mc.contains(key)) r.voxel = std::stod(mc[key].get<std::string>());
+    runs.push_back(std::move(r));
+  }
+  std::sort(runs.begin(), runs.end(), [](const RunRecord& a, const RunRecord& b) { return a.id < b.id; });
+  return runs;
+}
+
+std::string number(const json& v, const char* format = "{:.6g}") {
+  return v.is_number() ? fmt::format(fmt::runtime(format), v.get<double>()) : "";
+}
+
+const json& metric(const RunRecord& r, const char* raster, const char* which) {
+  static const json null;
+  // Runs without a raster (edf_circle before the EDF comparison, or with edf.enabled=false).
+  if (!r.summary.contains("metrics") || !r.summary["metrics"].contains(raster)) return null;
+  const json& m = r.summary["metrics"][raster];
+  return m.contains(which) && !m[which].is_null() ? m[which] : null;
+}
+
+std::string value(const RunRecord& r, const char* raster, const char* which, const char* name) {
+  const json& m = metric(r, raster, which);
+  return m.is_object() && m.contains(name) ? number(m[name]) : "";
+}
+
+// Table cells: coverage in percent, RMSE in metres, "-" when undefined.
+std::string coverage_cell(const RunRecord& r, const char* raster, const char* which) {
+  const std::string v = value(r, raster, which, "coverage");
+  return v.empty() ? std::string("-") : fmt::format("{:.1f}%", 100 * std::stod(v));
+}
+std::string rmse_cell(const RunRecord& r, const char* raster, const char* which) {
+  const std::string v = value(r, raster, which, "rmse");
+  return v.empty() ? std::string("-") : fmt::format("{:.3f}", std::stod(v));
+}
+
+// The EDF's bearing slip (summary "edf"."slip"), `which` = final or mean; "" when absent.
+std::string slip(const RunRecord& r, const char* which, const char* name) {
+  if (!r.summary.contains("edf") || !r.summary["edf"].is_object()) return "";
+  const json s = r.summary["edf"].value("slip", json::object());
+  return s.contains(which) && s[which].is_object() && s[which].contains(name) ? number(s[which][name], "{:.2f}") : "";
+}
+
+std::vector<std::string> stage_names(const std::vector<RunRecord>& runs) {
+  std::set<std::string> names;
+  for (const auto& r : runs)
+    for (const auto& item : r.timings.items()) names.insert(item.key());
+  return {names.begin(), names.end()};
+}
+
+std::string median(const RunRecord& r, const std::string& stage) {
+  return r.timings.contains(stage) ? number(r.timings[stage]["median_ms"], "{:.3f}") : "";
+}
+
+// Per scenario and raster: one line per run over frames, for a column of frames.csv.
+void plot_over_frames(const fs::path& png, const std::vector<const RunRecord*>& runs,
+                      const std::string& column, const std::string& title, const std::string& ylabel) {
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 1000,500 noenhanced font 'DejaVu Sans,11'\n"
+     << "set output '" << png.string() << "'\nset title '" << title << "'\n"
+     << "set xlabel 'frame'\nset ylabel '" << ylabel << "'\nset key outside right\nset grid\n"
+     << "set datafile separator ','\nplot ";
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const fs::path csv = runs[i]->dir / "frames.csv";
+    gp << (i ? ", \\\n     " : "") << "'" << csv.string() << "' using 'frame':'" << column
+       << "' with lines lw 2 title '" << runs[i]->variant << " s" << runs[i]->seed << "'";
+  }
+  gp << "\n";
+  draw_with_gnuplot(png, gp.str());
+}
+
+// Median stage times against voxel size, one line per (mapper, stage).
+void plot_time_vs_voxel(const fs::path& png, const std::vector<const RunRecord*>& runs,
+                        const std::vector<std::string>& stages) {
+  std::ostringstream gp;
+  gp << "set terminal pngcairo size 1000,500 noenhanced font 'DejaVu Sans,11'\n"
+     << "set output '" << png.string() << "'\nset title 'median time per frame vs voxel size'\n"
+     << "set xlabel 'voxel (m)'\nset ylabel 'ms per frame'\nset key outside right\nset grid\n"
+     << "set logscale y\n";
+  std::map<std::string, std::vector<const RunRecord*>> by_mapper;
+  for (const RunRecord* r : runs)
+    if (std::isfinite(r->voxel)) by_mapper[r->mapper].push_back(r);
+  std::vector<std::string> plots;
+  int block = 0;
+  for (auto& [mapper, list] : by_mapper) {
+    std::sort(list.begin(), list.end(), [](auto* a, auto* b) { return a->voxel < b->voxel; });
+    for (const std::string& stage : stages) {
+      std::string data;
+      for (const RunRecord* r : list)
+        if (r->timings.contains(stage))
+          data += fmt::format("{} {}\n", r->voxel, r->timings[stage]["median_ms"].get<double>());
+      if (data.empty()) continue;
+      gp << "$d" << block << " << EOD\n" << data << "EOD\n";
+      plots.push_back(fmt::format("$d{} using 1:2 with linespoints lw 2 title '{} {}'", block, mapper, stage));
+      ++block;
+    }
+  }
+  if (plots.empty()) return;
+  gp << "plot ";
+  for (std::size_t i = 0; i < plots.size(); ++i) gp << (i ? ", \\\n     " : "") << plots[i];
+  gp << "\n";
+  draw_with_gnuplot(png, gp.str());
+}
+
+}  // namespace
+
+int build_report(const fs::path& dir, bool quiet) {
+  const std::vector<RunRecord> runs = read_runs(dir);
+  if (runs.empty()) throw InputError(dir.string() + ": no finished run under " + (dir / "runs").string());
+  const std::vector<std::string> stages = stage_names(runs);
+
+  // rollup.csv: one row per run.
+  std::ostringstream csv;
+  csv << "run,scenario,variant,mapper,voxel,seed,frames";
+  for (const char* raster : {"circle", "cylinder", "edf_circle"})
+    for (const char* which : {"final", "mean"})
+      for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
+        csv << ',' << raster << '_' << which << '_' << name;
+  for (const char* which : {"final", "mean"})
+    for (const char* name : {"median_deg", "p90_deg"}) csv << ",edf_slip_" << which << '_' << name;
+  for (const auto& s : stages) csv << ",median_" << s << "_ms";
+  csv << '\n';
+  for (const RunRecord& r : runs) {
+    csv << r.id << ',' << r.scenario << ',' << r.variant << ',' << r.mapper << ','
+        << (std::isfinite(r.voxel) ? fmt::format("{}", r.voxel) : "") << ',' << r.seed << ','
+        << r.summary["config"].value("frames", 0);
+    for (const char* raster : {"circle", "cylinder", "edf_circle"})
+      for (const char* which : {"final", "mean"})
+        for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
+          csv << ',' << value(r, raster, which, name);
+    for (const char* which : {"final", "mean"})
+      for (const char* name : {"median_deg", "p90_deg"}) csv << ',' << slip(r, which, name);
+    for (const auto& s : stages) csv << ',' << median(r, s);
+    csv << '\n';
+  }
+  write_text_file(dir / "rollup.csv", csv.str());
+
+  // Plots per scenario.
+  fs::create_directories(dir / "plots");
+  std::map<std::string, std::vector<const RunRecord*>> by_scenario;
+  for (const RunRecord& r : runs) by_scenario[r.scenario].push_back(&r);
+  std::ostringstream md;
+  md << "# sonomap report: " << dir.filename().string() << "\n\n"
+     << runs.size() << " runs, rolled up from `" << (dir / "runs").string() << "` ("
+     << "`rollup.csv` has every number below). Coverage: known bins also occupied in the ground "
+        "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
+        "the estimate but empty in the truth or more than the tolerance closer (conventions.md).\n\n";
+  md << claims_section(read_claims(dir), csv.str());
+  for (const auto& [scenario, list] : by_scenario) {
+    md << "## " << scenario << "\n\n"
+       << "| run | mapper | voxel | circle cov. (final / mean) | circle RMSE (final / mean) | "
+          "circle ghosts (final) | cylinder cov. (final / mean) | cylinder RMSE (final / mean) | "
+          "cylinder ghosts (final) | integrate ms (median) |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const RunRecord* r : list) {
+      auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
+      auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
+      md << "| " << r->id << " | " << r->mapper << " | "
+         << (std::isfinite(r->voxel) ? fmt::format("{}", r->voxel) : "-") << " | "
+         << pct("circle", "final") << " / " << pct("circle", "mean") << " | " << rmse("circle", "final")
+         << " / " << rmse("circle", "mean") << " | " << value(*r, "circle", "final", "ghosts") << " | "
+         << pct("cylinder", "final") << " / " << pct("cylinder", "mean") << " | "
+         << rmse("cylinder", "final") << " / " << rmse("cylinder", "mean") << " | "
+         << value(*r, "cylinder", "final", "ghosts") << " | " << median(*r, "integrate") << " |\n";
+    }
+    md << "\n";
+    if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return r->summary.contains("edf"); })) {
+      // The paper's "Compare to EDF": the field's direction to the closest surface against each
+      // bin's bearing, and the circle the EDF gives by sphere tracing, beside the map's circle.
+      md << "### Compare to EDF\n\n"
+         << "Bearing slip: angle between the direction to the closest surface (the EDF's "
+            "-gradient at the bin's point on the sample circle) and the bin's ray, degrees, over "
+            "the bins where the field is observed. EDF circle: ranges sphere-traced in the field "
+            "along each bin's ray at the sensor's height.\n\n"
+         << "| run | mapper | slip median / p90 (final) | slip median / p90 (mean) | "
+            "EDF circle cov. (final / mean) | EDF circle RMSE (final / mean) | "
+            "map circle cov. / RMSE (final) |\n"
+         << "|---|---|---|---|---|---|---|\n";
+      auto or_dash = [](const std::string& v) { return v.empty() ? std::string("-") : v; };
+      for (const RunRecord* r : list) {
+        auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
+        auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
+        md << "| " << r->id << " | " << r->mapper << " | " << or_dash(slip(*r, "final", "median_deg"))
+           << " / " << or_dash(slip(*r, "final", "p90_deg")) << " | "
+           << or_dash(slip(*r, "mean", "median_deg")) << " / " << or_dash(slip(*r, "mean", "p90_deg"))
+           << " | " << pct("edf_circle", "final") << " / " << pct("edf_circle", "mean") << " | "
+           << rmse("edf_circle", "final") << " / " << rmse("edf_circle", "mean") << " | "
+           << pct("circle", "final") << " / " << rmse("circle", "final") << " |\n";
+      }
+      md << "\n";
+    }
+    const std::vector<std::pair<std::string, std::string>> series = {
+        {"circle_coverage", "circle coverage"}, {"cylinder_coverage", "cylinder coverage"},
+        {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
+        {"circle_rmse_off_edges", "circle RMSE off silhouette edges (m)"},
+        {"cylinder_rmse_off_edges", "cylinder RMSE off silhouette edges (m)"},
+        {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"}};
+    for (const auto& [column, label] : series) {
+      const std::string name = scenario + "_" + column + ".png";
+      plot_over_frames(dir / "plots" / name, list, column, scenario + ": " + label + " over frames", label);
+      md << "![" << label << "](plots/" << name << ")\n\n";
+    }
+    const std::string tname = scenario + "_time_vs_voxel.png";
+    plot_time_vs_voxel(dir / "plots" / tname, list, stages);
+    if (fs::exists(dir / "plots" / tname)) md << "![time vs voxel](plots/" << tname << ")\n\n";
+  }
+  write_text_file(dir / "report.md", md.str());
+  if (!quiet)
+    std::printf("report: %zu runs -> %s, %s, %s\n", runs.size(), (dir / "rollup.csv").c_str(),
+                (dir / "report.md").c_str(), (dir / "plots").c_str());
+  return static_cast<int>(runs.size());
+}
+
+void add_report_command(CLI::App& app, const GlobalOptions& global) {
+  auto dir = std::make_shared<fs::path>();
+  CLI::App* cmd = app.add_subcommand(
+      "report", "Roll up the finished runs under DIR/runs into rollup.csv, plots and report.md");
+  cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (or holding runs/)")->required();
+  cmd->callback([dir, &global] { build_report(*dir, global.quiet); });
+}
+
+}  // namespace sonomap::harness
