@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Binaural impulse responses held in memory: a measured HRIR set (any directions) used to
 // synthesise rooms, and a BRIR set on the paper's horizontal grid (azimuth x distance) used by
-// the sweep. Directions follow SOFA and conventions.md: x front, y left, z up, azimuth
+// the sweep. Directions follow SOFA and docs/conventions.md: x front, y left, z up, azimuth
 // counter-clockwise from the front. Files are read and written by harness/sofa_io.
 #pragma once
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The paper's "Compare to EDF" baseline: the circle read from a Euclidean distance field
 // instead of from the map's surface points. Per azimuth bin (same bins and azimuth convention
-// as the circle, conventions.md), on the horizontal plane through the sensor:
+// as the circle, docs/conventions.md), on the horizontal plane through the sensor:
 //  (a) the field at the bin's point on a circle of `sample_radius` around the sensor: its
 //      distance and its bearing slip, the angle between the direction to the closest surface
 //      (-gradient) and the bin's outward ray. The field points to whatever surface is closest,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One small Gaussian process over surface points, the building block of VDB-GPDF (mapping.md):
+// One small Gaussian process over surface points, the building block of VDB-GPDF (vdb_gpdf.hpp):
 // a latent occupancy-like field f (targets all 1, zero mean, prior variance 1) turned into a
 // distance d. Used for the local GPs (one per local leaf) and the global GPs (one per global
 // leaf, trained on marching-cubes zero crossings).

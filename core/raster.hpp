@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Sensor-centric rasters (conventions.md): the 2D circle (azimuth bins) and the 3D cylinder
+// Sensor-centric rasters (docs/conventions.md): the 2D circle (azimuth bins) and the 3D cylinder
 // (azimuth bins x height rows). Each cell keeps the minimum horizontal range of the obstacle
 // points that fall in it, and that point. Unknown is +infinity, distinct from any range.
 // The sonification sectors (groups of bins) are a pure function of a circle.
@@ -73,7 +73,7 @@ struct Cylinder {
 Circle make_circle(const RasterConfig& config);
 Cylinder make_cylinder(const RasterConfig& config);
 
-// One sonification sector (conventions.md "Sectors"): the bin with the smallest range among
+// One sonification sector (docs/conventions.md "Sectors"): the bin with the smallest range among
 // the sector's bins. Ties go to the lowest bin index (the first met counter-clockwise).
 struct Sector {
   float range = kUnknownRange;  // range of the closest bin; unknown if every bin is unknown

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Builds the circle and the cylinder (conventions.md) from world points around a RasterOrigin.
+// Builds the circle and the cylinder (docs/conventions.md) from world points around a RasterOrigin.
 // One accumulator reused frame after frame: reset() clears the cells, add() is O(1) per point
 // and never allocates, so a raster from N points costs O(N + cells).
 #pragma once

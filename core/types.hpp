@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Plain data shared by every module: frames from a depth sensor, and the raster origin.
-// Frames follow ../shared/docs/conventions.md: world z up; camera optical frame x right,
+// Frames follow docs/conventions.md: world z up; camera optical frame x right,
 // y down, z forward; body frame x forward, y left, z up.
 #pragma once
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// VDB-GPDF (Wu et al. 2024) as ../shared/docs/mapping.md describes it, with its fixes:
+// VDB-GPDF (Wu et al. 2024, "VDB-GPDF: Online Gaussian Process Distance Field with VDB
+// Structure"), with its fixes:
 // per frame, local GPs on a fine temporary VDB, signed distances at query points near the
 // surface and along free-space rays, weighted fusion into a global (distance, weight) VDB,
 // and a global GP per leaf trained on the marching-cubes zero crossings (G-GPDF).

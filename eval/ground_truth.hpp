@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The exact ground-truth circle and cylinder (conventions.md "Ground truth rasters") from the
+// The exact ground-truth circle and cylinder (docs/conventions.md "Ground truth rasters") from the
 // scene's true triangles at one instant: per cell, the minimum horizontal distance from the
 // raster origin over the triangles clipped to the cell's height slab and angular wedge.
 // This is the oracle for the rasteriser: it shares no code with it (only the raster types).

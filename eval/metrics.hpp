@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Per-frame accuracy of an estimated raster against the ground truth (conventions.md
+// Per-frame accuracy of an estimated raster against the ground truth (docs/conventions.md
 // "Metrics"), for the circle and the cylinder alike (a cylinder is compared cell by cell).
 #pragma once
 

@@ -129,7 +129,7 @@ class Open3dMap final : public BenchedMap {
     const double convert_ms = ms_since(t0);
     t0 = StageClock::now();
     // Open3D's extrinsic is camera_T_world; its camera frame (x right, y down, z forward) is
-    // our optical frame (conventions.md).
+    // our optical frame (docs/conventions.md).
     volume_.Integrate(*rgbd, intrinsic_, frame.world_T_camera.inverse().matrix());
     const double integrate_ms = ms_since(t0);
     stages.emplace_back("convert", convert_ms);

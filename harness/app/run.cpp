@@ -208,7 +208,7 @@ RunOutcome run_scenario(const RunOptions& options) {
 
   auto mapper = make_mapper(options.mapper, options.voxel, settings.mapper);
   if (!settings.ghost_tolerance_set) {
-    // conventions.md: a ghost is more than 2 voxels closer than the truth.
+    // docs/conventions.md: a ghost is more than 2 voxels closer than the truth.
     for (const auto& [key, value] : mapper->config_entries())
       if (key == "global_voxel" || key == "voxel") settings.metrics.ghost_tolerance = 2.0 * std::stod(value);
   }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The circle CSV: one row per 1-degree bin (conventions.md), header line "bin,range", exactly
+// The circle CSV: one row per 1-degree bin (docs/conventions.md), header line "bin,range", exactly
 // 360 rows with bins 0..359 in order; range in metres, empty when the bin is unknown.
 //   bin,range
 //   0,2.000

@@ -207,7 +207,8 @@ int build_report(const fs::path& dir, bool quiet) {
      << runs.size() << " runs, rolled up from `" << (dir / "runs").string() << "` ("
      << "`rollup.csv` has every number below). Coverage: known bins also occupied in the ground "
         "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
-        "the estimate but empty in the truth or more than the tolerance closer (conventions.md).\n\n";
+        "the estimate but empty in the truth or more than the tolerance closer "
+        "(docs/conventions.md).\n\n";
   md << claims_section(read_claims(dir), csv.str());
   for (const auto& [scenario, list] : by_scenario) {
     md << "## " << scenario << "\n\n"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Raster shapes and sonification sectors (conventions.md "Sectors").
+// Raster shapes and sonification sectors (docs/conventions.md "Sectors").
 #include "core/raster.hpp"
 
 #include <catch2/catch.hpp>

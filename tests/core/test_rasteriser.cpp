@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Hand-placed points give hand-computed bins (conventions.md "Azimuth", "2D circle", "3D cylinder").
+// Hand-placed points give hand-computed bins (docs/conventions.md "Azimuth", "Bins", "The circle
+// and the cylinder").
 #include "core/rasteriser.hpp"
 
 #include <catch2/catch.hpp>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Metrics on hand-made rasters (conventions.md "Metrics"), values worked out by hand.
+// Metrics on hand-made rasters (docs/conventions.md "Metrics"), values worked out by hand.
 #include "eval/metrics.hpp"
 
 #include <catch2/catch.hpp>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Binaural cues of taps rendered through BRIRs synthesised from the measured MIT KEMAR HRIRs
-// (reference values in docs/sonification.md): a tap at +90 degrees reaches the left ear
+// (the cues of a human-sized head): a tap at +90 degrees reaches the left ear
 // 0.55-0.8 ms earlier and is more than 8 dB louder in the 3-10 kHz band; 270 mirrors it;
 // straight ahead there is no interaural difference.
 #include "audio/brir_synth.hpp"
