@@ -36,6 +36,8 @@ int run_cli(int argc, char** argv) {
   add_brir_command(app, global);
   add_sonify_command(app, global);
   add_bench_command(app, global);
+  add_score_command(app, global);
+  add_diff_command(app, global);
 
   try {
     app.parse(argc, argv);

@@ -23,6 +23,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global);
 void add_brir_command(CLI::App& app, const GlobalOptions& global);
 void add_sonify_command(CLI::App& app, const GlobalOptions& global);
 void add_bench_command(CLI::App& app, const GlobalOptions& global);
+void add_score_command(CLI::App& app, const GlobalOptions& global);
+void add_diff_command(CLI::App& app, const GlobalOptions& global);
 
 // Parses argv and runs the chosen command. Returns the process exit status:
 // 0 success, 2 bad input (message names file, line and key), 1 other failure.

@@ -101,23 +101,27 @@ void append_frames_list(std::vector<std::string>& args, const char* option,
   for (const auto& f : frames) args.push_back(f);
 }
 
-// The `claims` list: each names a scenario and a variant of this sweep.
-std::vector<Claim> read_sweep_claims(const SweepReader& r, const YAML::Node& root, const Sweep& sweep) {
+// The `claims` or `gates` list: each names a scenario and a variant of this sweep. A gate has
+// no paper figure or note, and its text defaults to its check.
+std::vector<Claim> read_sweep_claims(const SweepReader& r, const YAML::Node& root, const Sweep& sweep,
+                                     const std::string& list_name) {
+  const bool gates = list_name == "gates";
   std::vector<Claim> claims;
-  const YAML::Node list = root["claims"];
+  const YAML::Node list = root[list_name];
   if (!list) return claims;
-  if (!list.IsSequence()) r.fail(list, "claims", "expected a list");
+  if (!list.IsSequence()) r.fail(list, list_name, "expected a list");
   std::set<std::string> scenarios, variants;
   for (const auto& s : root["scenarios"]) scenarios.insert(s["id"].as<std::string>());
   for (const auto& v : root["variants"]) variants.insert(v["id"].as<std::string>());
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node c = list[i];
-    const std::string key = "claims[" + std::to_string(i) + "]";
-    r.check_keys(c, key, {"text", "scenario", "variant", "metric", "op", "value", "versus", "paper", "note"});
+    const std::string key = list_name + "[" + std::to_string(i) + "]";
+    if (gates) r.check_keys(c, key, {"text", "scenario", "variant", "metric", "op", "value", "versus"});
+    else r.check_keys(c, key, {"text", "scenario", "variant", "metric", "op", "value", "versus", "paper", "note"});
     for (const char* required : {"text", "scenario", "variant", "metric", "op", "value"})
-      if (!c[required]) r.fail(c, key + "." + required, "missing");
+      if (!c[required] && !(gates && std::string(required) == "text")) r.fail(c, key + "." + required, "missing");
     Claim claim;
-    claim.text = r.scalar<std::string>(c["text"], key + ".text");
+    if (c["text"]) claim.text = r.scalar<std::string>(c["text"], key + ".text");
     claim.scenario = r.scalar<std::string>(c["scenario"], key + ".scenario");
     if (!scenarios.count(claim.scenario))
       r.fail(c["scenario"], key + ".scenario", "no scenario '" + claim.scenario + "' in " + sweep.name);
@@ -134,11 +138,30 @@ std::vector<Claim> read_sweep_claims(const SweepReader& r, const YAML::Node& roo
       if (!variants.count(claim.versus))
         r.fail(c["versus"], key + ".versus", "no variant '" + claim.versus + "' in " + sweep.name);
     }
+    if (claim.text.empty())
+      claim.text = fmt::format("{} {} {}{}", claim.metric, claim.op, claim.value,
+                               claim.versus.empty() ? "" : " x " + claim.versus);
     if (c["paper"]) claim.paper = r.scalar<std::string>(c["paper"], key + ".paper");
     if (c["note"]) claim.note = r.scalar<std::string>(c["note"], key + ".note");
     claims.push_back(std::move(claim));
   }
   return claims;
+}
+
+// An external mapper's variant runs `sonomap score --command`; it has no voxel or pictures of
+// a map (score draws the rasters it is given).
+void append_command_variant(const SweepReader& r, const YAML::Node& v, const std::string& vkey,
+                            const fs::path& out, std::vector<std::string>& args) {
+  if (v["voxel"]) r.fail(v["voxel"], vkey + ".voxel", "an external command has no voxel size (give it in its command)");
+  const std::string command = r.scalar<std::string>(v["command"], vkey + ".command");
+  if (command.find_first_not_of(" \t") == std::string::npos) r.fail(v["command"], vkey + ".command", "is empty");
+  double timeout = 600.0;
+  if (v["timeout"]) {
+    timeout = r.scalar<double>(v["timeout"], vkey + ".timeout");
+    if (!(timeout > 0.0 && timeout <= 7 * 86400.0)) r.fail(v["timeout"], vkey + ".timeout", "must be in (0, 604800] seconds");
+  }
+  args.insert(args.end(), {"--name", r.scalar<std::string>(v["id"], vkey + ".id"), "--command", command,
+                           "--timeout", fmt::format("{}", timeout), "--sequence-cache", (out / "sequences").string()});
 }
 
 }  // namespace
@@ -154,7 +177,7 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
   }
   SweepReader r(file);
   r.check_keys(root, "", {"name", "frames", "every", "seeds", "set", "scenarios", "variants",
-                          "pictures", "sweeps", "description", "claims"});
+                          "pictures", "sweeps", "description", "claims", "gates"});
   Sweep sweep;
   if (!root["name"]) r.fail(root, "name", "missing");
   sweep.name = r.identifier(root["name"], "name");
@@ -198,34 +221,40 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
     for (std::size_t vi = 0; vi < root["variants"].size(); ++vi) {
       const YAML::Node v = root["variants"][vi];
       const std::string vkey = "variants[" + std::to_string(vi) + "]";
-      r.check_keys(v, vkey, {"id", "mapper", "voxel", "set"});
-      if (!v["id"] || !v["mapper"]) r.fail(v, vkey, "needs id and mapper");
+      r.check_keys(v, vkey, {"id", "mapper", "voxel", "set", "command", "timeout"});
+      if (!v["id"] || !v["mapper"] == !v["command"]) r.fail(v, vkey, "needs id and either mapper or command");
       const std::string vid = r.identifier(v["id"], vkey + ".id");
       for (std::uint64_t seed : seeds) {
         Job job;
         job.id = fmt::format("{}-{}-s{}", sid, vid, seed);
         if (!ids.insert(job.id).second) r.fail(v["id"], vkey + ".id", "duplicate run id " + job.id);
         auto& a = job.args;
-        a = {"--quiet", "run", scenario_file.string(), "--out", (out / "runs" / job.id).string(),
-             "--mapper", r.scalar<std::string>(v["mapper"], vkey + ".mapper"),
+        a = {"--quiet", v["command"] ? "score" : "run", scenario_file.string(), "--out", (out / "runs" / job.id).string(),
              "--seed", std::to_string(seed), "--tag", "scenario=" + sid, "--tag", "variant=" + vid,
              "--tag", "sweep=" + sweep.name};
+        if (v["command"]) append_command_variant(r, v, vkey, out, a);
+        else a.insert(a.end(), {"--mapper", r.scalar<std::string>(v["mapper"], vkey + ".mapper")});
         if (v["voxel"]) {
           const double voxel = r.scalar<double>(v["voxel"], vkey + ".voxel");
           if (!(voxel > 0)) r.fail(v["voxel"], vkey + ".voxel", "must be positive");
           a.insert(a.end(), {"--voxel", fmt::format("{}", voxel)});
         }
         if (s_frames > 0) a.insert(a.end(), {"--frames", std::to_string(s_frames)});
-        if (s_every > 0) a.insert(a.end(), {"--every", std::to_string(s_every)});
+        // An external command evaluates the frames it chooses, has no built-in mapper to set
+        // up (mapper.* keys are for those) and makes no sweeps.
+        const bool external = static_cast<bool>(v["command"]);
+        if (s_every > 0 && !external) a.insert(a.end(), {"--every", std::to_string(s_every)});
         for (const auto& lists : {common_set, s_set, r.strings(v["set"], vkey + ".set")})
-          for (const auto& o : lists) a.insert(a.end(), {"--set", o});
+          for (const auto& o : lists)
+            if (!external || o.rfind("mapper.", 0) != 0) a.insert(a.end(), {"--set", o});
         append_frames_list(a, "--pictures", pictures);
-        append_frames_list(a, "--sweeps", sweeps);
+        if (!external) append_frames_list(a, "--sweeps", sweeps);
         sweep.jobs.push_back(std::move(job));
       }
     }
   }
-  sweep.claims = read_sweep_claims(r, root, sweep);
+  sweep.claims = read_sweep_claims(r, root, sweep, "claims");
+  sweep.gates = read_sweep_claims(r, root, sweep, "gates");
   return sweep;
 }
 
@@ -272,14 +301,21 @@ struct CompareOptions {
   int jobs = 1;
   bool emit_jobs = false;
   bool rerun = false;
+  fs::path junit;  // empty: no JUnit XML
 };
 
 int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   const Sweep sweep = load_sweep(o.sweep_file, o.out);
   const std::string program = self_program();
-  if (!sweep.claims.empty()) {  // `report` reads them from here, whoever runs the jobs
+  // `report` reads claims and gates from here, whoever runs the jobs.
+  // A sweep edited to have none removes the earlier file (compare wrote it).
+  for (const auto& [file, checks] : {std::pair{"claims.json", &sweep.claims}, std::pair{"gates.json", &sweep.gates}}) {
+    if (checks->empty()) {
+      fs::remove(o.out / file);
+      continue;
+    }
     fs::create_directories(o.out);
-    write_text_file(o.out / "claims.json", claims_to_json(sweep.claims).dump(2) + "\n");
+    write_text_file(o.out / file, claims_to_json(*checks).dump(2) + "\n");
   }
   if (o.emit_jobs) {
     std::fputs(job_list(sweep, program).c_str(), stdout);
@@ -338,8 +374,8 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
     return kExitInterrupted;
   }
   for (const auto& f : failed) std::fprintf(stderr, "compare: run failed: %s\n", f.c_str());
-  build_report(o.out, global.quiet);
-  return failed.empty() ? 0 : kExitFailure;
+  const ReportOutcome report = build_report(o.out, global.quiet, o.junit);
+  return failed.empty() && report.failed_gates == 0 ? 0 : kExitFailure;
 }
 
 }  // namespace
@@ -356,6 +392,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global) {
                 "Print one command per run (for GNU parallel or a Slurm array) and exit; "
                 "then `sonomap report DIR` rolls up");
   cmd->add_flag("--rerun", o->rerun, "Run again even the runs that finished before");
+  cmd->add_option("--junit", o->junit, "Also write JUnit XML: one test case per gate and claim");
   cmd->callback([o, &global] {
     const int status = run_compare(*o, global);
     if (status != 0) throw CLI::RuntimeError(status);

@@ -14,9 +14,15 @@
 //     - {id: room, file: room.yaml, frames: 600, set: [...]}
 //   variants:                         # required
 //     - {id: gpdf_5cm, mapper: vdb_gpdf, voxel: 0.05, set: [mapper.carving=false]}
+//     - {id: mine, command: "python3 my_mapper.py {sequence} {out}", timeout: 300}
+//       # an external mapper (score.hpp): run on the scenario rendered as a TUM sequence
+//       # ({sequence}, cached under <out>/sequences), it writes {out}/circle.csv (and optionally
+//       # cylinder.csv); {frames} is the frame count. No shell; timeout in seconds (default 600).
 //   pictures: [-1]                    # optional, passed to run --pictures
 //   sweeps: [-1]                      # optional, passed to run --sweeps
 //   claims: [...]                     # optional: the paper's figures to check (claims.hpp)
+//   gates:                            # optional: CI gates; report and compare exit 1 if one fails
+//     - {scenario: room, variant: gpdf_5cm, metric: circle_mean_rmse, op: "<=", value: 0.1}
 #pragma once
 
 #include "harness/app/cli.hpp"
@@ -37,6 +43,7 @@ struct Sweep {
   std::string name;
   std::vector<Job> jobs;
   std::vector<Claim> claims;
+  std::vector<Claim> gates;
 };
 
 // Parses and validates a sweep file; job outputs go to <out>/runs/<id>.

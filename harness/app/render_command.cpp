@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `sonomap render SCENARIO.yaml --out DIR`: the simulated depth frames as a TUM RGB-D sequence.
+#include "harness/app/render_command.hpp"
+
 #include "harness/app/cli.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/formats/tum_io.hpp"
@@ -38,14 +40,15 @@ void check_replaceable(const fs::path& out) {
     throw InputError(out.string() + ": exists and is not a depth sequence; choose another --out");
 }
 
-void render(const RenderOptions& options, const GlobalOptions& global) {
-  std::vector<std::string> overrides = options.overrides;
-  if (options.frames > 0) overrides.push_back("frames=" + std::to_string(options.frames));
-  const sim::Scenario scenario = load_scenario(options.scenario, overrides);
+}  // namespace
+
+void render_sequence(const fs::path& scenario_file, const std::vector<std::string>& overrides,
+                     const fs::path& out, bool quiet) {
+  const sim::Scenario scenario = load_scenario(scenario_file, overrides);
 
   CameraFile camera{scenario.name, scenario.camera, kTumDepthScale};
   if (camera.camera.max_range * camera.depth_scale > 65535.0)
-    throw InputError(options.scenario, 0, "sensor.max_range",
+    throw InputError(scenario_file.string(), 0, "sensor.max_range",
                      "a 16-bit PNG at " + std::to_string(static_cast<int>(kTumDepthScale)) +
                          " per metre holds depths up to " + std::to_string(65535.0 / kTumDepthScale) +
                          " m; lower max_range to render this scenario");
@@ -54,16 +57,15 @@ void render(const RenderOptions& options, const GlobalOptions& global) {
   try {
     simulation = std::make_unique<sim::Simulation>(scenario);
   } catch (const std::invalid_argument& e) {
-    throw InputError(options.scenario, 0, "", e.what());
+    throw InputError(scenario_file.string(), 0, "", e.what());
   }
 
-  const fs::path out = options.out;
   check_replaceable(out);
   install_interrupt_handler();  // Ctrl-C unwinds: the staged directory is removed
   StagedDirectory staged(out, /*replace=*/true);
   TumWriter writer(staged.path(), camera);
   const int frames = simulation->frame_count();
-  Progress progress("render", frames, global.quiet);
+  Progress progress("render", frames, quiet);
   for (int i = 0; i < frames; ++i) {
     throw_if_interrupted();
     writer.add(simulation->render(i));
@@ -72,12 +74,10 @@ void render(const RenderOptions& options, const GlobalOptions& global) {
   writer.finish();
   progress.finish();
   staged.commit();
-  if (!global.quiet)
+  if (!quiet)
     std::printf("render: %d frames of '%s' written to %s\n", frames, scenario.name.c_str(),
                 out.string().c_str());
 }
-
-}  // namespace
 
 void add_render_command(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<RenderOptions>();
@@ -96,7 +96,11 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--set", options->overrides,
                       "Override a scenario key, e.g. --set sensor.noise.model=none (repeatable)")
       ->allow_extra_args(false);  // one key=value per --set, so a scenario after it stays positional
-  command->callback([options, &global] { render(*options, global); });
+  command->callback([options, &global] {
+    std::vector<std::string> overrides = options->overrides;
+    if (options->frames > 0) overrides.push_back("frames=" + std::to_string(options->frames));
+    render_sequence(options->scenario, overrides, options->out, global.quiet);
+  });
 }
 
 }  // namespace sonomap::harness

@@ -2,6 +2,7 @@
 #include "harness/app/run.hpp"
 
 #include "harness/app/frame_source.hpp"
+#include "harness/app/result_files.hpp"
 #include "harness/app/run_settings.hpp"
 
 #include "core/edf_raster.hpp"
@@ -45,42 +46,7 @@ using eval::RasterMetrics;
 
 using Clock = StageClock;
 
-// A range for CSV: empty when unknown; fixed precision so reruns compare byte for byte.
-std::string csv_range(const RasterCell& cell) {
-  return cell.known() ? fmt::format("{:.6f}", cell.range) : std::string();
-}
-
 std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v) : ""; }
-
-json metrics_json(const RasterMetrics& m) {
-  auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
-  return json{{"coverage", num(m.coverage)}, {"rmse", num(m.rmse)},
-              {"rmse_off_edges", num(m.rmse_off_edges)}, {"edge_cells", m.edge_cells},
-              {"ghosts", m.ghosts},          {"known_in_both", m.known_in_both},
-              {"truth_occupied", m.truth_occupied}, {"estimate_known", m.estimate_known},
-              {"cells", m.cells}};
-}
-
-// Mean of a metric over frames where it is defined.
-struct MetricSeries {
-  std::vector<RasterMetrics> frames;
-  json summary() const {
-    double cov = 0, rmse = 0, rmse_off = 0, ghosts = 0;
-    int n_cov = 0, n_rmse = 0, n_off = 0;
-    for (const auto& m : frames) {
-      if (std::isfinite(m.coverage)) cov += m.coverage, ++n_cov;
-      if (std::isfinite(m.rmse)) rmse += m.rmse, ++n_rmse;
-      if (std::isfinite(m.rmse_off_edges)) rmse_off += m.rmse_off_edges, ++n_off;
-      ghosts += m.ghosts;
-    }
-    json mean{{"coverage", n_cov ? json(cov / n_cov) : json(nullptr)},
-              {"rmse", n_rmse ? json(rmse / n_rmse) : json(nullptr)},
-              {"rmse_off_edges", n_off ? json(rmse_off / n_off) : json(nullptr)},
-              {"ghosts", frames.empty() ? json(nullptr) : json(ghosts / frames.size())}};
-    return json{{"final", frames.empty() ? json(nullptr) : metrics_json(frames.back())},
-                {"mean", mean}};
-  }
-};
 
 json slip_json(const SlipStats& s) {
   auto num = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
@@ -108,29 +74,6 @@ void write_edf_csv(const fs::path& file, int frame, const Circle& map_circle, co
 bool chosen(const std::vector<int>& list, int frame, int last_evaluated) {
   if (list.empty()) return frame == last_evaluated;
   return std::find(list.begin(), list.end(), frame) != list.end();
-}
-
-// FNV-1a over the canonical JSON of the configuration: a short, stable config hash.
-std::string config_hash(const json& config) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : config.dump()) h = (h ^ c) * 1099511628211ull;
-  return fmt::format("{:016x}", h);
-}
-
-std::string pose_csv(const Eigen::Isometry3d& world_T_body) {
-  const Eigen::Vector3d p = world_T_body.translation();
-  return fmt::format("{:.6f},{:.6f},{:.6f},{:.4f}", p.x(), p.y(), p.z(),
-                     heading_of(world_T_body) * 180.0 / M_PI);
-}
-
-json tags_json(const std::vector<std::string>& tags) {
-  json out = json::object();
-  for (const std::string& t : tags) {
-    const auto eq = t.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError("--tag " + t + ": expected key=value");
-    out[t.substr(0, eq)] = t.substr(eq + 1);
-  }
-  return out;
 }
 
 // The sweep renderer, made at the first sweep: BRIRs from --brir, or synthesised for a shoebox
@@ -223,11 +166,7 @@ RunOutcome run_scenario(const RunOptions& options) {
 
   std::ofstream frames_csv(dir / "frames.csv"), timings_csv(dir / "timings.csv");
   std::ofstream circle_csv, cylinder_csv;
-  frames_csv << "frame,time,x,y,z,heading_deg,"
-                "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
-                "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
-                "cylinder_known,edf_coverage,edf_rmse,edf_rmse_off_edges,edf_ghosts,edf_known,"
-                "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known\n";
+  frames_csv << frames_csv_header();
   if (options.write_rasters) {
     circle_csv.open(dir / "circle.csv");
     cylinder_csv.open(dir / "cylinder.csv");
@@ -239,7 +178,7 @@ RunOutcome run_scenario(const RunOptions& options) {
   const int last_evaluated = frame_count - 1;
   Rasteriser rasteriser(settings.raster);
   std::vector<Eigen::Vector3f> surface;
-  MetricSeries circle_series, cylinder_series, edf_series;
+  std::vector<RasterMetrics> circle_series, cylinder_series, edf_series;
   std::vector<SlipStats> slip_series;
   int evaluated = 0;
   std::vector<std::string> timing_columns;
@@ -285,8 +224,8 @@ RunOutcome run_scenario(const RunOptions& options) {
         times.emplace_back("truth", ms_since(t0));
         mc = eval::compare(rasteriser.circle(), truth.circle, settings.metrics);
         my = eval::compare(rasteriser.cylinder(), truth.cylinder, settings.metrics);
-        circle_series.frames.push_back(mc);
-        cylinder_series.frames.push_back(my);
+        circle_series.push_back(mc);
+        cylinder_series.push_back(my);
       }
       // The EDF comparison (edf.*): every edf.every-th evaluated frame, the last and the
       // pictured ones. A mapper without a field gets an all-unknown EDF circle, not a guess.
@@ -309,7 +248,7 @@ RunOutcome run_scenario(const RunOptions& options) {
         me.estimate_known = edf->traced.known_count();
         if (has_truth) {
           me = eval::compare(edf->traced, truth.circle, settings.metrics);
-          edf_series.frames.push_back(me);
+          edf_series.push_back(me);
         }
         if (i == last_evaluated)
           write_edf_csv(dir / "edf.csv", i, rasteriser.circle(), *edf, truth.circle, origin.ground_z);
@@ -332,15 +271,8 @@ RunOutcome run_scenario(const RunOptions& options) {
       frames_csv << '\n';
 
       if (options.write_rasters) {
-        const Circle& c = rasteriser.circle();
-        for (int k = 0; k < c.size(); ++k)
-          circle_csv << i << ',' << k << ',' << csv_range(c.bins[k]) << ','
-                     << csv_range(truth.circle.bins[k]) << '\n';
-        const Cylinder& y = rasteriser.cylinder();
-        for (int r = 0; r < y.rows; ++r)
-          for (int k = 0; k < y.azimuth_bins; ++k)
-            cylinder_csv << i << ',' << r << ',' << k << ',' << csv_range(y.at(r, k)) << ','
-                         << csv_range(truth.cylinder.at(r, k)) << '\n';
+        write_circle_rows(circle_csv, i, rasteriser.circle(), truth.circle);
+        write_cylinder_rows(cylinder_csv, i, rasteriser.cylinder(), truth.cylinder);
       }
       if (chosen(options.picture_frames, i, last_evaluated)) {
         const std::string stem = fmt::format("frame_{:06d}", i);
@@ -409,11 +341,11 @@ RunOutcome run_scenario(const RunOptions& options) {
                {"config_hash", config_hash(config)},
                {"evaluated_frames", evaluated},
                {"tags", tags},
-               {"metrics", {{"circle", circle_series.summary()},
-                            {"cylinder", cylinder_series.summary()}}}};
+               {"metrics", {{"circle", metrics_summary(circle_series)},
+                            {"cylinder", metrics_summary(cylinder_series)}}}};
   if (settings.edf_enabled) {
     // The EDF circle's metrics sit beside the map's; the slip (no truth needed) in "edf".
-    summary["metrics"]["edf_circle"] = edf_series.summary();
+    summary["metrics"]["edf_circle"] = metrics_summary(edf_series);
     double median = 0.0, p90 = 0.0;
     int n = 0;
     for (const SlipStats& s : slip_series)

@@ -10,7 +10,9 @@
 #include "core/raster.hpp"
 
 #include <filesystem>
+#include <map>
 #include <string>
+#include <vector>
 
 namespace sonomap::harness {
 
@@ -22,5 +24,24 @@ Circle read_circle_csv(const std::filesystem::path& file);
 // The CSV text of a circle (unknown bins empty), and an atomic write of it.
 std::string circle_csv(const Circle& circle);
 void write_circle_csv(const std::filesystem::path& file, const Circle& circle);
+
+}  // namespace sonomap::harness
+
+namespace sonomap::harness {
+
+// The rasters a run writes (run.hpp, circle.csv / cylinder.csv) and `score` reads, from any
+// program: header "frame,bin,estimate" (circle) or "frame,row,bin,estimate" (cylinder), an
+// optional extra "truth" column (ignored), one row per cell, range in metres, empty when
+// unknown. Every listed frame must list each of its cells exactly once.
+struct RasterFrames {
+  int rows = 0;  // 0: circle rows (frame,bin,...)
+  int bins = 0;
+  std::map<int, std::vector<RasterCell>> frames;  // frame -> cells, row-major (row * bins + bin)
+};
+
+// Reads such a file; `rows` = 0 for the circle. InputError "file:line: key: what" on a missing
+// or wrong header, a frame outside [0, frame_count), a row or bin out of range, a range that is
+// NaN, infinite, negative or not a number, a duplicate cell, or a frame with missing cells.
+RasterFrames read_raster_frames(const std::filesystem::path& file, int rows, int bins, int frame_count);
 
 }  // namespace sonomap::harness

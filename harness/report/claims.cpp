@@ -16,15 +16,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
 bool holds(double ours, const std::string& op, double value) {
   if (op == ">=") return ours >= value;
   if (op == "<=") return ours <= value;
@@ -47,8 +38,8 @@ nlohmann::json claims_to_json(const std::vector<Claim>& claims) {
   return out;
 }
 
-std::vector<Claim> read_claims(const fs::path& dir) {
-  const fs::path file = dir / "claims.json";
+std::vector<Claim> read_claims(const fs::path& dir, const std::string& file_name) {
+  const fs::path file = dir / file_name;
   std::ifstream in(file);
   if (!in) return {};
   std::vector<Claim> claims;
@@ -69,61 +60,129 @@ std::vector<Claim> read_claims(const fs::path& dir) {
   return claims;
 }
 
-std::string claims_section(const std::vector<Claim>& claims, const std::string& rollup_csv) {
-  if (claims.empty()) return {};
-  std::istringstream in(rollup_csv);
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = split_csv_line(line);
-  std::map<std::string, std::size_t> column;
-  for (std::size_t i = 0; i < header.size(); ++i) column[header[i]] = i;
-  std::vector<std::vector<std::string>> rows;
-  while (std::getline(in, line))
-    if (!line.empty()) rows.push_back(split_csv_line(line));
+ClaimCheck check_claim(const Claim& c, const RollupTable& rollup) {
+  const int scenario = rollup.column("scenario"), variant = rollup.column("variant");
+  const int metric = rollup.column(c.metric);
+  // Mean of the metric over the rows of (scenario, variant); NaN when there is none.
+  auto figure = [&](const std::string& variant_id) {
+    double sum = 0.0;
+    int n = 0;
+    for (const auto& row : rollup.rows) {
+      const double v = rollup.number(row, metric);
+      if (rollup.cell(row, scenario) != c.scenario || rollup.cell(row, variant) != variant_id || !std::isfinite(v))
+        continue;
+      sum += v;
+      ++n;
+    }
+    return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
+  };
+  ClaimCheck check;
+  check.ours = "not measured";
+  check.check = c.op + ' ' + (c.versus.empty() ? fmt::format("{:g}", c.value) : fmt::format("{:g} x {}", c.value, c.versus));
+  if (metric < 0) return check;
+  const double mine = figure(c.variant);
+  const double other = c.versus.empty() ? 1.0 : figure(c.versus);
+  if (!std::isfinite(mine) || !std::isfinite(other)) return check;
+  check.measured = true;
+  check.ours = fmt::format("{:.4g}", mine);
+  if (!c.versus.empty()) check.ours += fmt::format(" ({}: {:.4g})", c.versus, other);
+  check.holds = holds(mine, c.op, c.value * other);
+  return check;
+}
 
+std::string claims_section(const std::vector<Claim>& claims, const RollupTable& rollup) {
+  if (claims.empty()) return {};
   std::ostringstream md;
   md << "## Against the paper\n\n"
      << "Each of the paper's figures that this sweep reproduces, checked against our runs (mean "
         "over seeds). A claim that differs is not a test failure: it is a finding, and its note "
         "says why.\n\n"
      << "| claim | paper | ours | check | verdict | note |\n|---|---|---|---|---|---|\n";
-  // Mean of `metric` over the rows of (scenario, variant); NaN when there is none.
-  auto figure = [&](const std::string& scenario, const std::string& variant, const std::string& metric) {
-    const auto col = column.find(metric);
-    if (col == column.end() || !column.count("scenario") || !column.count("variant"))
-      return std::numeric_limits<double>::quiet_NaN();
-    double sum = 0.0;
-    int n = 0;
-    for (const auto& row : rows) {
-      if (row.size() <= col->second || row[column["scenario"]] != scenario ||
-          row[column["variant"]] != variant || row[col->second].empty())
-        continue;
-      sum += std::stod(row[col->second]);
-      ++n;
-    }
-    return n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
-  };
   int agree = 0, differ = 0;
   for (const Claim& c : claims) {
-    std::string ours = "not measured", verdict = "-";
-    const double mine = figure(c.scenario, c.variant, c.metric);
-    const double other = c.versus.empty() ? 1.0 : figure(c.scenario, c.versus, c.metric);
-    if (std::isfinite(mine) && std::isfinite(other)) {
-      ours = fmt::format("{:.4g}", mine);
-      if (!c.versus.empty()) ours += fmt::format(" ({}: {:.4g})", c.versus, other);
-      const bool ok = holds(mine, c.op, c.value * other);
-      verdict = ok ? "agrees" : "**differs**";
-      ++(ok ? agree : differ);
+    const ClaimCheck check = check_claim(c, rollup);
+    std::string verdict = "-";
+    if (check.measured) {
+      verdict = check.holds ? "agrees" : "**differs**";
+      ++(check.holds ? agree : differ);
     }
-    const std::string bound = c.versus.empty() ? fmt::format("{:g}", c.value)
-                                               : fmt::format("{:g} x {}", c.value, c.versus);
     md << "| " << c.text << " (" << c.scenario << " / " << c.variant << ", `" << c.metric
-       << "`) | " << c.paper << " | " << ours << " | " << c.op << ' ' << bound << " | " << verdict
+       << "`) | " << c.paper << " | " << check.ours << " | " << check.check << " | " << verdict
        << " | " << c.note << " |\n";
   }
   md << "\n" << agree << " agree, " << differ << " differ, "
      << (claims.size() - agree - differ) << " not measured.\n\n";
   return md.str();
+}
+
+std::string gates_section(const std::vector<Claim>& gates, const RollupTable& rollup, int& failed) {
+  failed = 0;
+  if (gates.empty()) return {};
+  std::ostringstream md;
+  md << "## Gates\n\nThe sweep's CI gates (mean over seeds); a gate that fails or cannot be "
+        "measured makes `report` and `compare` exit with status 1.\n\n"
+     << "| gate | scenario / variant | metric | ours | check | result |\n|---|---|---|---|---|---|\n";
+  for (const Claim& g : gates) {
+    const ClaimCheck check = check_claim(g, rollup);
+    const bool pass = check.measured && check.holds;
+    if (!pass) ++failed;
+    md << "| " << g.text << " | " << g.scenario << " / " << g.variant << " | `" << g.metric << "` | "
+       << check.ours << " | " << check.check << " | " << (pass ? "pass" : "**FAIL**") << " |\n";
+  }
+  md << "\n" << gates.size() - failed << " of " << gates.size() << " gates pass.\n\n";
+  return md.str();
+}
+
+namespace {
+
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// One <testsuite>: a gate fails when it does not hold or is not measured; a claim that
+// differs or is not measured is skipped (a finding, not a failure).
+std::string junit_suite(const std::string& name, const std::vector<Claim>& checks,
+                        const RollupTable& rollup, bool gates) {
+  std::ostringstream cases;
+  int failures = 0, skipped = 0;
+  for (const Claim& c : checks) {
+    const ClaimCheck check = check_claim(c, rollup);
+    const std::string what = fmt::format("{} / {}: {} = {}, expected {}", c.scenario, c.variant,
+                                         c.metric, check.ours, check.check);
+    cases << "    <testcase classname=\"sonomap." << name << '.' << xml_escape(c.scenario) << '.'
+          << xml_escape(c.variant) << "\" name=\"" << xml_escape(c.text) << "\">\n";
+    if (!(check.measured && check.holds) && gates) {
+      cases << "      <failure message=\"" << xml_escape(what) << "\"/>\n";
+      ++failures;
+    } else if (!(check.measured && check.holds)) {
+      const std::string why = check.measured ? "differs from the paper: " : "";
+      cases << "      <skipped message=\"" << xml_escape(why + what) << "\"/>\n";
+      ++skipped;
+    }
+    cases << "      <system-out>" << xml_escape(what) << "</system-out>\n    </testcase>\n";
+  }
+  return fmt::format("  <testsuite name=\"sonomap {}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"{}\">\n",
+                     name, checks.size(), failures, skipped) + cases.str() + "  </testsuite>\n";
+}
+
+}  // namespace
+
+std::string junit_xml(const std::vector<Claim>& claims, const std::vector<Claim>& gates,
+                      const RollupTable& rollup) {
+  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"sonomap\">\n" +
+         junit_suite("gates", gates, rollup, true) + junit_suite("claims", claims, rollup, false) +
+         "</testsuites>\n";
 }
 
 }  // namespace sonomap::harness

@@ -15,6 +15,8 @@
 //       note: "why a difference is expected, if it is"
 #pragma once
 
+#include "harness/report/rollup.hpp"
+
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -34,14 +36,35 @@ struct Claim {
   std::string note;
 };
 
+// CI gates (compare.hpp `gates:`) are claims that must hold: the same fields (text optional,
+// no paper or note), checked the same way; a gate that fails or cannot be measured fails the
+// report (exit status 1).
+
 bool is_claim_operator(const std::string& op);
 
 nlohmann::json claims_to_json(const std::vector<Claim>& claims);
-// Reads DIR/claims.json; none if the file does not exist. Throws InputError if it is malformed.
-std::vector<Claim> read_claims(const std::filesystem::path& dir);
+// Reads DIR/<file_name>; none if the file does not exist. Throws InputError if it is malformed.
+std::vector<Claim> read_claims(const std::filesystem::path& dir, const std::string& file_name = "claims.json");
 
-// The report's "Against the paper" section: each claim checked against the roll-up
-// (rollup.csv's text): our figure (mean over the matching runs), the check and its verdict.
-std::string claims_section(const std::vector<Claim>& claims, const std::string& rollup_csv);
+// One claim checked against the roll-up: our figure is the mean of the metric over the runs of
+// (scenario, variant); with `versus`, the bound is value x that variant's mean.
+struct ClaimCheck {
+  bool measured = false;  // both figures exist
+  bool holds = false;
+  std::string ours;   // "0.93", or "0.93 (depth: 0.4)", or "not measured"
+  std::string check;  // ">= 0.99" or "< 0.5 x depth"
+};
+ClaimCheck check_claim(const Claim& claim, const RollupTable& rollup);
+
+// The report's "Against the paper" section: each claim, our figure, the check and its verdict.
+std::string claims_section(const std::vector<Claim>& claims, const RollupTable& rollup);
+
+// The report's "Gates" section; `failed` counts the gates that fail or are not measured.
+std::string gates_section(const std::vector<Claim>& gates, const RollupTable& rollup, int& failed);
+
+// JUnit XML: a test suite of gates (failure when one fails or is not measured) and one of
+// claims (a claim that differs from the paper is a finding, reported as skipped, not failed).
+std::string junit_xml(const std::vector<Claim>& claims, const std::vector<Claim>& gates,
+                      const RollupTable& rollup);
 
 }  // namespace sonomap::harness

@@ -3,6 +3,8 @@
 #include "harness/report/report.hpp"
 
 #include "harness/report/pictures.hpp"
+#include "harness/report/rollup.hpp"
+#include "harness/report/stats_report.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"
 
@@ -167,7 +169,7 @@ void plot_time_vs_voxel(const fs::path& png, const std::vector<const RunRecord*>
 
 }  // namespace
 
-int build_report(const fs::path& dir, bool quiet) {
+ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& junit) {
   const std::vector<RunRecord> runs = read_runs(dir);
   if (runs.empty()) throw InputError(dir.string() + ": no finished run under " + (dir / "runs").string());
   const std::vector<std::string> stages = stage_names(runs);
@@ -175,24 +177,14 @@ int build_report(const fs::path& dir, bool quiet) {
   // rollup.csv: one row per run.
   std::ostringstream csv;
   csv << "run,scenario,variant,mapper,voxel,seed,frames";
-  for (const char* raster : {"circle", "cylinder", "edf_circle"})
-    for (const char* which : {"final", "mean"})
-      for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
-        csv << ',' << raster << '_' << which << '_' << name;
-  for (const char* which : {"final", "mean"})
-    for (const char* name : {"median_deg", "p90_deg"}) csv << ",edf_slip_" << which << '_' << name;
+  for (const auto& [name, unused] : summary_metrics(json::object())) csv << ',' << name;
   for (const auto& s : stages) csv << ",median_" << s << "_ms";
   csv << '\n';
   for (const RunRecord& r : runs) {
     csv << r.id << ',' << r.scenario << ',' << r.variant << ',' << r.mapper << ','
         << (std::isfinite(r.voxel) ? fmt::format("{}", r.voxel) : "") << ',' << r.seed << ','
         << r.summary["config"].value("frames", 0);
-    for (const char* raster : {"circle", "cylinder", "edf_circle"})
-      for (const char* which : {"final", "mean"})
-        for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
-          csv << ',' << value(r, raster, which, name);
-    for (const char* which : {"final", "mean"})
-      for (const char* name : {"median_deg", "p90_deg"}) csv << ',' << slip(r, which, name);
+    for (const auto& [name, cell] : summary_metrics(r.summary)) csv << ',' << cell;
     for (const auto& s : stages) csv << ',' << median(r, s);
     csv << '\n';
   }
@@ -209,7 +201,12 @@ int build_report(const fs::path& dir, bool quiet) {
         "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
         "the estimate but empty in the truth or more than the tolerance closer "
         "(docs/conventions.md).\n\n";
-  md << claims_section(read_claims(dir), csv.str());
+  const RollupTable rollup = RollupTable::parse(csv.str());
+  const std::vector<Claim> claims = read_claims(dir), gates = read_claims(dir, "gates.json");
+  ReportOutcome outcome{static_cast<int>(runs.size()), 0};
+  md << gates_section(gates, rollup, outcome.failed_gates) << claims_section(claims, rollup)
+     << stats_section(dir, rollup);
+  if (!junit.empty()) write_text_file(junit, junit_xml(claims, gates, rollup));
   for (const auto& [scenario, list] : by_scenario) {
     md << "## " << scenario << "\n\n"
        << "| run | mapper | voxel | circle cov. (final / mean) | circle RMSE (final / mean) | "
@@ -272,15 +269,23 @@ int build_report(const fs::path& dir, bool quiet) {
   if (!quiet)
     std::printf("report: %zu runs -> %s, %s, %s\n", runs.size(), (dir / "rollup.csv").c_str(),
                 (dir / "report.md").c_str(), (dir / "plots").c_str());
-  return static_cast<int>(runs.size());
+  if (outcome.failed_gates > 0)
+    std::fprintf(stderr, "report: %d of %zu gates fail (see %s)\n", outcome.failed_gates, gates.size(),
+                 (dir / "report.md").c_str());
+  return outcome;
 }
 
 void add_report_command(CLI::App& app, const GlobalOptions& global) {
   auto dir = std::make_shared<fs::path>();
+  auto junit = std::make_shared<fs::path>();
   CLI::App* cmd = app.add_subcommand(
-      "report", "Roll up the finished runs under DIR/runs into rollup.csv, plots and report.md");
+      "report", "Roll up the finished runs under DIR/runs into rollup.csv, rollup_stats.csv, "
+                "pairs.csv, plots and report.md; exit status 1 when a gate fails");
   cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (or holding runs/)")->required();
-  cmd->callback([dir, &global] { build_report(*dir, global.quiet); });
+  cmd->add_option("--junit", *junit, "Also write JUnit XML: one test case per gate and claim");
+  cmd->callback([dir, junit, &global] {
+    if (build_report(*dir, global.quiet, *junit).failed_gates > 0) throw CLI::RuntimeError(kExitFailure);
+  });
 }
 
 }  // namespace sonomap::harness

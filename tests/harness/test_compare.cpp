@@ -2,7 +2,10 @@
 // compare: every combination of a sweep file is an independent run; the report rolls up what
 // exists; a rerun skips finished runs; the job list is one command per run.
 #include "cli_support.hpp"
+#include "score_support.hpp"
 #include "test_scenario_files.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <csignal>
@@ -175,4 +178,59 @@ TEST_CASE("an interrupted sweep keeps its finished runs, leaves no partial one, 
   CHECK(resumed.output.find(std::to_string(kept) + " finished before, " + std::to_string(4 - kept) +
                             " to run") != std::string::npos);
   CHECK(finished() == 4);
+}
+
+// An external mapper as a sweep variant: a python3 program with only the standard library that
+// reads the rendered sequence's frame list and writes a constant-range circle for its last
+// frame. It is scored beside a built-in mapper; a failing and a timed-out command fail their
+// own runs only. Its RMSE is the closed-form one of a constant circle in the square room.
+TEST_CASE("a sweep variant may be an external command, scored beside the built-in mappers",
+          "[compare][score]") {
+  if (sonomap::harness::run_program({"python3", "-c", "pass"}) != 0) {
+    WARN("skipped: python3 is not installed (an external mapper needs it)");
+    return;
+  }
+  sonomap::test::ScratchDir scratch("compare-command");
+  scratch.write("square.yaml", sonomap::test::square_room_scenario());
+  const fs::path mapper = scratch.write(
+      "my_mapper.py",
+      "import os, sys\n"
+      "sequence, out, frames = sys.argv[1], sys.argv[2], int(sys.argv[3])\n"
+      "stamps = [l for l in open(os.path.join(sequence, 'depth.txt')) if not l.startswith('#')]\n"
+      "assert len(stamps) == frames, (len(stamps), frames)\n"
+      "with open(os.path.join(out, 'circle.csv'), 'w') as f:\n"
+      "    f.write('frame,bin,estimate\\n')\n"
+      "    for b in range(360):\n"
+      "        f.write('%d,%d,%s\\n' % (frames - 1, b, sys.argv[4]))\n");
+  const std::string sweep_text =
+      "name: external\nseeds: [1]\nset: [edf.enabled=false]\n"
+      "scenarios:\n  - {id: square, file: square.yaml}\n"
+      "variants:\n"
+      "  - {id: depth, mapper: depth_only}\n"
+      "  - {id: mine, command: \"python3 '" + mapper.string() + "' {sequence} {out} {frames} 1.5\"}\n"
+      "  - {id: broken, command: \"python3 -c 'import sys; sys.exit(3)'\"}\n"
+      "  - {id: slow, command: \"python3 -c 'import time; time.sleep(30)'\", timeout: 0.5}\n"
+      "pictures: [-1]\nsweeps: [-1]\n";
+  const fs::path sweep = scratch.write("sweep.yaml", sweep_text);
+  const fs::path out = scratch.path() / "out";
+  const auto r = sonomap::test::run_sonomap({"--quiet", "compare", sweep.string(), "--out", out.string(), "-j", "2"});
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("run failed: square-broken-s1") != std::string::npos);
+  CHECK(r.output.find("run failed: square-slow-s1") != std::string::npos);
+  CHECK(sonomap::test::text_of(out / "logs" / "square-broken-s1.log").find("exited with status 3") != std::string::npos);
+  CHECK(sonomap::test::text_of(out / "logs" / "square-slow-s1.log").find("timed out after 0.5 s") != std::string::npos);
+  REQUIRE(fs::exists(out / "runs" / "square-mine-s1" / "summary.json"));
+  CHECK(fs::exists(out / "runs" / "square-depth-s1" / "summary.json"));
+  CHECK(!fs::exists(out / "runs" / "square-broken-s1"));
+  const auto summary = nlohmann::json::parse(sonomap::test::text_of(out / "runs" / "square-mine-s1" / "summary.json"));
+  CHECK(summary["metrics"]["circle"]["final"]["rmse"].get<double>() ==
+        Approx(sonomap::test::square_room_rmse(1.5)).epsilon(1e-6));
+  const std::string rollup = sonomap::test::text_of(out / "rollup.csv");
+  CHECK(rollup.find("square-mine-s1,square,mine,mine,") != std::string::npos);
+  CHECK(rollup.find("square-depth-s1,square,depth,depth_only,") != std::string::npos);
+  // The sequence was rendered once, into the cache.
+  int sequences = 0;
+  for (const auto& e : fs::directory_iterator(out / "sequences")) sequences += e.is_directory();
+  CHECK(sequences == 1);
 }
