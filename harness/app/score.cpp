@@ -163,6 +163,17 @@ struct Scores {
   std::vector<eval::RasterMetrics> circle, cylinder;
 };
 
+// A program's circle has ranges only: put each known bin's point at its range along the bin's
+// centre ray, so the picture shows where the program says the obstacles are.
+void place_points(Circle& circle, const RasterOrigin& origin) {
+  for (int k = 0; k < circle.size(); ++k) {
+    RasterCell& c = circle.bins[k];
+    if (!c.known()) continue;
+    const double azimuth = origin.heading + circle.bin_centre_deg(k) * M_PI / 180.0;
+    c.point = (origin.position + c.range * Eigen::Vector3d(std::cos(azimuth), std::sin(azimuth), 0.0)).cast<float>();
+  }
+}
+
 bool pictured(const std::vector<int>& chosen, int frame, int last) {
   if (chosen.empty()) return frame == last;
   return std::find(chosen.begin(), chosen.end(), frame) != chosen.end();
@@ -189,6 +200,7 @@ Scores score_frames(const Estimates& estimates, FrameSource& source, const RunSe
     const eval::GroundTruthRasters truth = eval::ground_truth_rasters(*source.truth(frame.time), origin, settings.raster);
     Circle circle(settings.raster.azimuth_bins);
     circle.bins = cells;
+    place_points(circle, origin);
     Cylinder cylinder = make_cylinder(settings.raster);
     if (with_cylinder) cylinder.cells = estimates.cylinder.frames.at(i);
     scores.circle.push_back(eval::compare(circle, truth.circle, settings.metrics));

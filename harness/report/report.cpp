@@ -117,9 +117,27 @@ std::string median(const RunRecord& r, const std::string& stage) {
   return r.timings.contains(stage) ? number(r.timings[stage]["median_ms"], "{:.3f}") : "";
 }
 
-// Per scenario and raster: one line per run over frames, for a column of frames.csv.
-void plot_over_frames(const fs::path& png, const std::vector<const RunRecord*>& runs,
+// Whether a column of a run's frames.csv has a value in any row (a scored program's cylinder,
+// or recorded data's metrics, may have none).
+bool has_values(const RunRecord& r, const std::string& column) {
+  std::ifstream in(r.dir / "frames.csv");
+  std::string line;
+  if (!std::getline(in, line)) return false;
+  const RollupTable header = RollupTable::parse(line);
+  const int c = header.column(column);
+  while (c >= 0 && std::getline(in, line))
+    if (!header.cell(split_csv_line(line), c).empty()) return true;
+  return false;
+}
+
+// Per scenario and raster: one line per run over frames, for a column of frames.csv (runs
+// without a value in it left out; no picture when none has one).
+void plot_over_frames(const fs::path& png, std::vector<const RunRecord*> runs,
                       const std::string& column, const std::string& title, const std::string& ylabel) {
+  fs::remove(png);  // an earlier report's picture
+  runs.erase(std::remove_if(runs.begin(), runs.end(), [&](const RunRecord* r) { return !has_values(*r, column); }),
+             runs.end());
+  if (runs.empty()) return;
   std::ostringstream gp;
   gp << "set terminal pngcairo size 1000,500 noenhanced font 'DejaVu Sans,11'\n"
      << "set output '" << png.string() << "'\nset title '" << title << "'\n"
@@ -259,7 +277,7 @@ ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& juni
     for (const auto& [column, label] : series) {
       const std::string name = scenario + "_" + column + ".png";
       plot_over_frames(dir / "plots" / name, list, column, scenario + ": " + label + " over frames", label);
-      md << "![" << label << "](plots/" << name << ")\n\n";
+      if (fs::exists(dir / "plots" / name)) md << "![" << label << "](plots/" << name << ")\n\n";
     }
     const std::string tname = scenario + "_time_vs_voxel.png";
     plot_time_vs_voxel(dir / "plots" / tname, list, stages);

@@ -12,6 +12,10 @@
 
 namespace sonomap::harness {
 
+// The cells of one CSV line (no quoting: sonomap's CSVs hold none); a trailing comma is an
+// empty last cell.
+std::vector<std::string> split_csv_line(const std::string& line);
+
 struct RollupTable {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;

@@ -74,6 +74,7 @@ SampleStats group_stats(const Runs& runs, const RollupTable& t, const std::strin
 // Mean with its 95% interval as error bars, one point per variant.
 void plot_with_error_bars(const fs::path& png, const std::string& title,
                           const std::vector<std::pair<std::string, SampleStats>>& points) {
+  fs::remove(png);  // an earlier report's picture
   std::ostringstream gp, data;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const SampleStats& s = points[i].second;

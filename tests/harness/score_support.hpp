@@ -15,7 +15,7 @@ inline std::string square_room_scenario() {
          "sensor:\n  width: 160\n  height: 120\n"
          "  intrinsics: {fx: 131.25, fy: 131.25, cx: 79.5, cy: 59.5}\n"
          "  min_range: 0.3\n  max_range: 5.0\n  rate: 30\n  noise: {model: none}\n"
-         "body:\n  keyframes:\n    - {time: 0.0, position: [0.0, 0.0, 1.5], yaw: 0}\n"
+         "body:\n  interpolation: linear_slerp\n  keyframes:\n    - {time: 0.0, position: [0.0, 0.0, 1.5], yaw: 0}\n"
          "    - {time: 1.0, position: [0.0, 0.0, 1.5], yaw: 0}\n"
          "static:\n  - name: room\n    room: {size: [4.0, 4.0, 2.5]}\n";
 }
