@@ -154,32 +154,19 @@ std::vector<float> decaying_noise(size_t length, double fs, const std::vector<do
   return out;
 }
 
-// Gives the two ears' tails the same energy in every sixth of an octave (the mean of the two),
-// as a diffuse field has at the ears of a symmetric head: two independent noises differ by
-// several dB in a narrow band, which would make a source straight ahead lean to one side.
-// The per-bin gains are smooth in frequency (triangular weights in log frequency), so they
-// act as short filters and keep the decay.
-void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs) {
-  const size_t n = left.size();
-  const RealFft fft(next_power_of_two(n) * 2);  // zero padding: no circular wrap
-  AlignedSamples time(fft.size(), 0.0f);
-  Spectrum l(fft.bins()), r(fft.bins());
-  std::copy(left.begin(), left.end(), time.begin());
-  fft.forward(time.data(), l.data());
-  std::fill(time.begin(), time.end(), 0.0f);
-  std::copy(right.begin(), right.end(), time.begin());
-  fft.forward(time.data(), r.data());
-
-  constexpr double kLowest = 50.0, kPerOctave = 6.0;
+// Gives two spectra the same energy in every twelfth of an octave (the mean of the two). The
+// per-bin gains are smooth in frequency (triangular weights in log frequency): short filters.
+void balance_spectra(Spectrum& l, Spectrum& r, double fs, size_t fft_size) {
+  constexpr double kLowest = 50.0, kPerOctave = 12.0;
   const size_t bands = static_cast<size_t>(std::ceil(kPerOctave * std::log2(0.5 * fs / kLowest))) + 1;
-  // Each bin lies between two band centres: its position in bands and its upper weight.
+  // Each bin lies between two band centres: the lower one and the upper one's weight.
   auto place = [&](size_t k) {
-    const double x = kPerOctave * std::log2(std::max(k * fs / fft.size(), kLowest) / kLowest);
+    const double x = kPerOctave * std::log2(std::max(k * fs / fft_size, kLowest) / kLowest);
     const size_t b = std::min(static_cast<size_t>(x), bands - 1);
     return std::make_pair(b, std::min(1.0, x - b));
   };
   std::vector<double> el(bands + 1, 0.0), er(bands + 1, 0.0);
-  for (size_t k = 0; k < fft.bins(); ++k) {
+  for (size_t k = 0; k < l.size(); ++k) {
     const auto [b, w] = place(k);
     el[b] += (1.0 - w) * std::norm(l[k]), el[b + 1] += w * std::norm(l[k]);
     er[b] += (1.0 - w) * std::norm(r[k]), er[b + 1] += w * std::norm(r[k]);
@@ -189,15 +176,51 @@ void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs
     const double mean = 0.5 * (el[b] + er[b]);
     if (el[b] > 0.0 && er[b] > 0.0) gl[b] = std::sqrt(mean / el[b]), gr[b] = std::sqrt(mean / er[b]);
   }
-  for (size_t k = 0; k < fft.bins(); ++k) {
+  for (size_t k = 0; k < l.size(); ++k) {
     const auto [b, w] = place(k);
     l[k] *= static_cast<float>((1.0 - w) * gl[b] + w * gl[b + 1]);
     r[k] *= static_cast<float>((1.0 - w) * gr[b] + w * gr[b + 1]);
   }
-  fft.inverse(l.data(), time.data());
-  for (size_t i = 0; i < n; ++i) left[i] = time[i] / fft.size();
-  fft.inverse(r.data(), time.data());
-  for (size_t i = 0; i < n; ++i) right[i] = time[i] / fft.size();
+}
+
+// Gives the two ears' tails the same energy in every twelfth of an octave and every ~43 ms
+// frame, as a diffuse field has at the ears of a symmetric head: two independent noises differ
+// by several dB in a narrow band, which would make a source straight ahead lean to one side.
+// Hann frames at 50% overlap (they sum to one), each balanced and added back whole (zero
+// padded: the short balancing filters do not wrap around).
+void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs) {
+  const size_t n = left.size();
+  const size_t frame = next_power_of_two(static_cast<size_t>(0.04 * fs)), hop = frame / 2;
+  const size_t pad = frame / 2;  // the frame sits mid-buffer
+  const RealFft fft(2 * frame);
+  AlignedSamples time(fft.size());
+  Spectrum l(fft.bins()), r(fft.bins());
+  std::vector<float> out_l(n + 3 * frame, 0.0f), out_r(n + 3 * frame, 0.0f);
+  auto analyse = [&](const std::vector<float>& x, long start, Spectrum& spectrum) {
+    std::fill(time.begin(), time.end(), 0.0f);
+    for (size_t i = 0; i < frame; ++i) {
+      const long j = start + static_cast<long>(i);
+      const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);  // periodic Hann
+      if (j >= 0 && j < static_cast<long>(n)) time[pad + i] = static_cast<float>(w * x[j]);
+    }
+    fft.forward(time.data(), spectrum.data());
+  };
+  auto add_back = [&](Spectrum& spectrum, std::vector<float>& out, long start) {
+    fft.inverse(spectrum.data(), time.data());
+    for (size_t i = 0; i < fft.size(); ++i) {
+      // out starts at -(hop + pad): the filters spread either side of the frame
+      const long j = start + static_cast<long>(i) + static_cast<long>(hop);
+      if (j >= 0 && j < static_cast<long>(out.size())) out[j] += time[i] / fft.size();
+    }
+  };
+  for (long start = -static_cast<long>(hop); start < static_cast<long>(n); start += hop) {
+    analyse(left, start, l);
+    analyse(right, start, r);
+    balance_spectra(l, r, fs, fft.size());
+    add_back(l, out_l, start);
+    add_back(r, out_r, start);
+  }
+  for (size_t i = 0; i < n; ++i) left[i] = out_l[i + hop + pad], right[i] = out_r[i + hop + pad];
 }
 
 // Noise streams of one source direction: each (azimuth, distance) and ear has its own.

@@ -72,7 +72,8 @@ Eigen::Vector3d listener_position(const BrirSynthConfig& config);
 
 // Synthesises BRIR sets for one room. The late tail is noise of its own for every source
 // direction and ear (a shared tail would give every response the same spectral quirks and the
-// same left/right lean), balanced so both ears get the same energy in every sixth of an octave.
+// same left/right lean), balanced so both ears get the same energy in every twelfth of an
+// octave and every ~43 ms.
 class BrirSynthesizer {
  public:
   BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config);  // keeps its own copy

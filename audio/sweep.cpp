@@ -289,14 +289,15 @@ void SweepRenderer::level(SweepAudio& out) {
   } else {
     if (!fixed_gain_known_) {
       const SweepAudio loudest = mix(loudest_events());
-      fixed_gain_db_ = loudness_gain_db(
-          measure_loudness(loudest.left, loudest.right, loudest.sample_rate), rules);
+      const LoudnessMeasure m = measure_loudness(loudest.left, loudest.right, loudest.sample_rate);
+      fixed_gain_db_ = loudness_gain_db(m, rules);
+      fixed_peak_limited_ = peak_limited(m, rules);
       fixed_gain_known_ = true;
     }
     // The last line of defence: a sweep louder than the calibration one is turned down.
     const double cap = rules.ceiling_dbtp - rules.margin_db - raw.true_peak_dbtp;
     out.gain_db = std::min(fixed_gain_db_, cap);
-    out.peak_limited = cap < fixed_gain_db_;
+    out.peak_limited = fixed_peak_limited_ || cap < fixed_gain_db_;
   }
   apply_gain(out.left, out.right, out.gain_db);
   out.loudness = with_gain(raw, out.gain_db);

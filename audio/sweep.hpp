@@ -146,6 +146,7 @@ class SweepRenderer {
 
   double fixed_gain_db_ = 0.0;
   bool fixed_gain_known_ = false;
+  bool fixed_peak_limited_ = false;
   SweepConfig config_;
   std::map<double, Variant> taps_;  // by pitch shift, semitones
   Variant woosh_;

@@ -127,6 +127,8 @@ SofaContents read_sofa(const fs::path& file) {
   out.sample_rate = rate;
   out.conventions = conventions;
   out.room_type = attribute(h, "RoomType");
+  for (const MYSOFA_ATTRIBUTE* a = h.attributes; a; a = a->next)
+    if (a->name) out.attributes[a->name] = a->value ? a->value : "";
   const Eigen::Matrix3d to_head = room ? head_frame(h) : Eigen::Matrix3d::Identity();
   const Eigen::Vector3d head = room ? array3(h.ListenerPosition) : Eigen::Vector3d::Zero();
   if (!to_head.allFinite() || !head.allFinite())

@@ -14,6 +14,7 @@
 #include "audio/brir_set.hpp"
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@ struct SofaContents {
   std::vector<audio::BinauralIr> irs;
   std::string conventions;  // SOFAConventions
   std::string room_type;
+  std::map<std::string, std::string> attributes;  // every global attribute, as stored
 };
 
 // Reads a SimpleFreeFieldHRIR or SingleRoomMIMOSRIR file libmysofa loads. No resampling.
