@@ -2,29 +2,17 @@
 // BRIR files as AES69 SingleRoomMIMOSRIR: written with netCDF, loaded back through libmysofa,
 // the mandatory attributes filled, positions in room coordinates that turn back into the
 // head-frame grid, every sample equal, and the same bytes on every write.
+#include "cli_support.hpp"
 #include "harness/formats/sofa_io.hpp"
 #include "test_scenario_files.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 namespace fs = std::filesystem;
 using namespace sonomap;
 using namespace sonomap::harness;
-
-namespace {
-
-std::string bytes_of(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-}  // namespace
 
 TEST_CASE("BRIR SOFA files are SingleRoomMIMOSRIR with the mandatory attributes, read back "
           "through libmysofa sample for sample",
@@ -79,5 +67,5 @@ TEST_CASE("BRIR SOFA files are SingleRoomMIMOSRIR with the mandatory attributes,
 
   const fs::path again = scratch.path() / "again.sofa";
   write_brir_sofa(again, 48000.0, 1.2, azimuths, irs, meta);
-  CHECK(bytes_of(file) == bytes_of(again));  // no timestamps
+  CHECK(sonomap::test::text_of(file) == sonomap::test::text_of(again));  // no timestamps
 }

@@ -5,6 +5,7 @@
 #include "harness/formats/sofa_io.hpp"
 #include "harness/formats/wav_io.hpp"
 #include "harness/support/errors.hpp"
+#include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -171,14 +172,6 @@ TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a
   fs::remove_all(dir);
 }
 
-namespace {
-std::string bytes_of(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-}  // namespace
 
 TEST_CASE("two renders of a sweep are byte-identical, WAV and events", "[cli][sonify]") {
   const sonomap::test::ScratchDir scratch("sonify-twice");
@@ -193,10 +186,11 @@ TEST_CASE("two renders of a sweep are byte-identical, WAV and events", "[cli][so
     REQUIRE(r.status == 0);
     if (std::string(name) == "a.wav") sleep(1);  // a timestamp in the file would differ
   }
-  CHECK(bytes_of(dir / "a.wav").size() > 44);
-  CHECK(bytes_of(dir / "a.wav") == bytes_of(dir / "b.wav"));
-  CHECK(bytes_of(dir / "a.events.csv") == bytes_of(dir / "b.events.csv"));
-  CHECK(bytes_of(dir / "a.wav").find("PEAK") == std::string::npos);
+  using sonomap::test::text_of;
+  CHECK(text_of(dir / "a.wav").size() > 44);
+  CHECK(text_of(dir / "a.wav") == text_of(dir / "b.wav"));
+  CHECK(text_of(dir / "a.events.csv") == text_of(dir / "b.events.csv"));
+  CHECK(text_of(dir / "a.wav").find("PEAK") == std::string::npos);
 }
 
 TEST_CASE("absurd rooms and an IR shorter than the direct sound are refused: exit 2, nothing "
