@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "audio/brir_set.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -82,30 +83,56 @@ BrirSet::BrirSet(double sample_rate, BrirGrid grid, std::vector<BinauralIr> irs)
   }
 }
 
-size_t BrirSet::nearest_azimuth(double azimuth_deg) const {
+size_t nearest_distance_index(const std::vector<double>& values, double metres) {
+  if (values.empty()) throw std::invalid_argument("nearest distance: empty grid");
+  constexpr double kTie = 1e-6;
+  size_t best = 0;
+  for (size_t i = 1; i < values.size(); ++i) {
+    const double diff = std::abs(metres - values[i]), best_diff = std::abs(metres - values[best]);
+    if (diff < best_diff - kTie || (diff <= best_diff + kTie && values[i] > values[best])) best = i;
+  }
+  return best;
+}
+
+size_t nearest_azimuth_index(const std::vector<double>& values, double degrees) {
+  if (values.empty()) throw std::invalid_argument("nearest azimuth: empty grid");
   size_t best = 0;
   double best_diff = 1e9;
-  for (size_t i = 0; i < grid_.azimuths_deg.size(); ++i) {
-    const double diff = std::abs(wrap_degrees_180(azimuth_deg - grid_.azimuths_deg[i]));
+  for (size_t i = 0; i < values.size(); ++i) {
+    const double diff = std::abs(wrap_degrees_180(degrees - values[i]));
     if (diff < best_diff - 1e-9) best_diff = diff, best = i;
   }
   return best;
 }
 
+size_t BrirSet::nearest_azimuth(double azimuth_deg) const {
+  return nearest_azimuth_index(grid_.azimuths_deg, azimuth_deg);
+}
+
 size_t BrirSet::nearest_distance(double metres) const {
-  size_t best = 0;
-  double best_diff = 1e9;
-  for (size_t i = 0; i < grid_.distances_m.size(); ++i) {
-    const double diff = std::abs(metres - grid_.distances_m[i]);
-    if (diff < best_diff - 1e-9) best_diff = diff, best = i;
-  }
-  return best;
+  return nearest_distance_index(grid_.distances_m, metres);
 }
 
 const BinauralIr& BrirSet::at(size_t distance_index, size_t azimuth_index) const {
   if (distance_index >= distance_count() || azimuth_index >= azimuth_count())
     throw std::invalid_argument("BRIR set: index out of range");
   return irs_[distance_index * azimuth_count() + azimuth_index];
+}
+
+double BrirSet::normalise_to_reference() {
+  double loudest = 0.0;
+  for (const BinauralIr& ir : irs_)
+    for (const auto* ear : {&ir.left, &ir.right}) {
+      double energy = 0.0;
+      for (float x : *ear) energy += double(x) * x;
+      loudest = std::max(loudest, energy);
+    }
+  if (!(loudest > 0.0)) return 1.0;
+  const double factor = 1.0 / std::sqrt(loudest);
+  for (BinauralIr& ir : irs_)
+    for (auto* ear : {&ir.left, &ir.right})
+      for (float& x : *ear) x = static_cast<float>(x * factor);
+  return factor;
 }
 
 }  // namespace sonomap::audio

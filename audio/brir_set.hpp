@@ -55,6 +55,12 @@ class BrirSet {
   size_t nearest_distance(double metres) const;
   const BinauralIr& at(size_t distance_index, size_t azimuth_index) const;
 
+  // Scales the set to the reference level every set is played at: its loudest response (one
+  // ear at one grid point, energy = sum of squared samples) gets unit energy, so sets from
+  // different rooms, HRIRs or files start from the same level. Returns the factor applied
+  // (1 for an all-zero set).
+  double normalise_to_reference();
+
  private:
   double sample_rate_ = 0.0;
   BrirGrid grid_;
@@ -64,5 +70,12 @@ class BrirSet {
 
 // Angle difference a - b wrapped to (-180, 180].
 double wrap_degrees_180(double degrees);
+
+// Index of the value nearest to `metres` (values non-empty). A value within 1 um of a midpoint
+// is a tie (grid values may come from float files or sums like 3 x 0.4), and a tie goes to
+// the larger distance, as ordinary rounding does: 1.0 m on a 0.4 m grid plays 1.2 m.
+size_t nearest_distance_index(const std::vector<double>& values, double metres);
+// Index of the azimuth nearest to `degrees` on the circle (ties: the first listed).
+size_t nearest_azimuth_index(const std::vector<double>& values, double degrees);
 
 }  // namespace sonomap::audio

@@ -65,23 +65,33 @@ Eigen::Vector3d listener_position(const BrirSynthConfig& c) {
 
 void validate(const BrirSynthConfig& c) {
   const Eigen::Vector3d s = c.room.size();
-  require(c.room.min_corner.allFinite() && c.room.max_corner.allFinite() && (s.array() > 0.1).all(),
-          "room must be finite and larger than 0.1 m on every axis");
+  require(c.room.min_corner.allFinite() && c.room.max_corner.allFinite() &&
+              c.room.min_corner.cwiseAbs().maxCoeff() <= kRoomBounds.max_coordinate_m &&
+              c.room.max_corner.cwiseAbs().maxCoeff() <= kRoomBounds.max_coordinate_m,
+          "room corners must be finite and within 10 km of the origin");
+  require((s.array() >= kRoomBounds.min_side_m).all() && (s.array() <= kRoomBounds.max_side_m).all(),
+          "room sides must be in [1, 500] m, got " + std::to_string(s.x()) + " x " +
+              std::to_string(s.y()) + " x " + std::to_string(s.z()));
   const Eigen::Vector3d l = listener_position(c);
   require(l.allFinite() && (l.array() > c.room.min_corner.array()).all() &&
               (l.array() < c.room.max_corner.array()).all(),
           "listener must be inside the room");
-  require(std::isfinite(c.rt60) && c.rt60 > 0.01 && c.rt60 < 20.0,
-          "rt60 must be in (0.01, 20) s, got " + std::to_string(c.rt60));
+  const double wall = std::min((l - c.room.min_corner).minCoeff(), (c.room.max_corner - l).minCoeff());
+  require(wall >= kRoomBounds.min_wall_distance_m,
+          "listener must be at least 0.25 m from every wall, floor and ceiling (is " +
+              std::to_string(wall) + " m)");
+  const std::string rt60_range = "rt60 must be in (0.01, 3] s";
+  require(std::isfinite(c.rt60) && c.rt60 > 0.01 && c.rt60 <= kRoomBounds.max_rt60_s,
+          rt60_range + ", got " + std::to_string(c.rt60));
   require(c.band_rt60.empty() || c.band_rt60.size() == octave_band_centres().size(),
           "band_rt60 needs one value per octave band (7)");
   for (double t : c.band_rt60)
-    require(std::isfinite(t) && t > 0.01 && t < 20.0, "band rt60 must be in (0.01, 20) s");
+    require(std::isfinite(t) && t > 0.01 && t <= kRoomBounds.max_rt60_s, "band " + rt60_range);
   require(c.max_order >= 0 && c.max_order <= 30, "max_order must be in [0, 30]");
   require(std::isfinite(c.sample_rate) && c.sample_rate >= 8000 && c.sample_rate <= 384000,
           "sample rate must be in [8000, 384000] Hz");
-  require(std::isfinite(c.length_s) && c.length_s >= 0.0 && c.length_s <= 20.0,
-          "length must be in [0, 20] s");
+  require(std::isfinite(c.length_s) && c.length_s >= 0.0 && c.length_s <= kRoomBounds.max_rt60_s,
+          "length must be in [0, 3] s");
   require(std::isfinite(c.speed_of_sound) && c.speed_of_sound > 100.0, "speed of sound");
   require(std::isfinite(c.wall_margin) && c.wall_margin >= 0.0, "wall margin must be >= 0");
   require(std::isfinite(c.listener_heading_deg), "listener heading must be finite");
@@ -94,7 +104,8 @@ namespace {
 
 // Uniform noise of unit variance from our own stream (portable across standard libraries).
 std::vector<float> unit_noise(size_t n, uint64_t seed, uint64_t stream) {
-  std::seed_seq seq{seed, stream};
+  // seed_seq takes 32-bit words: give it all 128 bits.
+  std::seed_seq seq{uint32_t(seed), uint32_t(seed >> 32), uint32_t(stream), uint32_t(stream >> 32)};
   std::mt19937_64 rng(seq);
   std::vector<float> out(n);
   const double scale = std::sqrt(3.0);
@@ -143,6 +154,82 @@ std::vector<float> decaying_noise(size_t length, double fs, const std::vector<do
   return out;
 }
 
+// Gives two spectra the same energy in every twelfth of an octave (the mean of the two). The
+// per-bin gains are smooth in frequency (triangular weights in log frequency): short filters.
+void balance_spectra(Spectrum& l, Spectrum& r, double fs, size_t fft_size) {
+  constexpr double kLowest = 50.0, kPerOctave = 12.0;
+  const size_t bands = static_cast<size_t>(std::ceil(kPerOctave * std::log2(0.5 * fs / kLowest))) + 1;
+  // Each bin lies between two band centres: the lower one and the upper one's weight.
+  auto place = [&](size_t k) {
+    const double x = kPerOctave * std::log2(std::max(k * fs / fft_size, kLowest) / kLowest);
+    const size_t b = std::min(static_cast<size_t>(x), bands - 1);
+    return std::make_pair(b, std::min(1.0, x - b));
+  };
+  std::vector<double> el(bands + 1, 0.0), er(bands + 1, 0.0);
+  for (size_t k = 0; k < l.size(); ++k) {
+    const auto [b, w] = place(k);
+    el[b] += (1.0 - w) * std::norm(l[k]), el[b + 1] += w * std::norm(l[k]);
+    er[b] += (1.0 - w) * std::norm(r[k]), er[b + 1] += w * std::norm(r[k]);
+  }
+  std::vector<double> gl(bands + 1, 1.0), gr(bands + 1, 1.0);
+  for (size_t b = 0; b <= bands; ++b) {
+    const double mean = 0.5 * (el[b] + er[b]);
+    if (el[b] > 0.0 && er[b] > 0.0) gl[b] = std::sqrt(mean / el[b]), gr[b] = std::sqrt(mean / er[b]);
+  }
+  for (size_t k = 0; k < l.size(); ++k) {
+    const auto [b, w] = place(k);
+    l[k] *= static_cast<float>((1.0 - w) * gl[b] + w * gl[b + 1]);
+    r[k] *= static_cast<float>((1.0 - w) * gr[b] + w * gr[b + 1]);
+  }
+}
+
+// Gives the two ears' tails the same energy in every twelfth of an octave and every ~43 ms
+// frame, as a diffuse field has at the ears of a symmetric head: two independent noises differ
+// by several dB in a narrow band, which would make a source straight ahead lean to one side.
+// Hann frames at 50% overlap (they sum to one), each balanced and added back whole (zero
+// padded: the short balancing filters do not wrap around).
+void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs) {
+  const size_t n = left.size();
+  const size_t frame = next_power_of_two(static_cast<size_t>(0.04 * fs)), hop = frame / 2;
+  const size_t pad = frame / 2;  // the frame sits mid-buffer
+  const RealFft fft(2 * frame);
+  AlignedSamples time(fft.size());
+  Spectrum l(fft.bins()), r(fft.bins());
+  std::vector<float> out_l(n + 3 * frame, 0.0f), out_r(n + 3 * frame, 0.0f);
+  auto analyse = [&](const std::vector<float>& x, long start, Spectrum& spectrum) {
+    std::fill(time.begin(), time.end(), 0.0f);
+    for (size_t i = 0; i < frame; ++i) {
+      const long j = start + static_cast<long>(i);
+      const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);  // periodic Hann
+      if (j >= 0 && j < static_cast<long>(n)) time[pad + i] = static_cast<float>(w * x[j]);
+    }
+    fft.forward(time.data(), spectrum.data());
+  };
+  auto add_back = [&](Spectrum& spectrum, std::vector<float>& out, long start) {
+    fft.inverse(spectrum.data(), time.data());
+    for (size_t i = 0; i < fft.size(); ++i) {
+      // out starts at -(hop + pad): the filters spread either side of the frame
+      const long j = start + static_cast<long>(i) + static_cast<long>(hop);
+      if (j >= 0 && j < static_cast<long>(out.size())) out[j] += time[i] / fft.size();
+    }
+  };
+  for (long start = -static_cast<long>(hop); start < static_cast<long>(n); start += hop) {
+    analyse(left, start, l);
+    analyse(right, start, r);
+    balance_spectra(l, r, fs, fft.size());
+    add_back(l, out_l, start);
+    add_back(r, out_r, start);
+  }
+  for (size_t i = 0; i < n; ++i) left[i] = out_l[i + hop + pad], right[i] = out_r[i + hop + pad];
+}
+
+// Noise streams of one source direction: each (azimuth, distance) and ear has its own.
+uint64_t direction_stream(double azimuth_deg, double distance_m) {
+  const auto az = static_cast<uint64_t>(std::llround((wrap_degrees_180(azimuth_deg) + 180.0) * 1000.0));
+  const auto mm = static_cast<uint64_t>(std::llround(distance_m * 1000.0));
+  return (az * 1000003u + mm) * 2u;
+}
+
 // One axis of the image lattice: coordinate of the image and its number of reflections.
 struct AxisImage {
   double coordinate;
@@ -177,9 +264,13 @@ BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
   std::vector<double> band_rt60 = config_.band_rt60;
   if (band_rt60.empty()) band_rt60.assign(octave_band_centres().size(), config_.rt60);
   const double longest = *std::max_element(band_rt60.begin(), band_rt60.end());
-  const double seconds = config_.length_s > 0.0 ? config_.length_s : longest;
-  length_ = std::max<size_t>(static_cast<size_t>(std::ceil(seconds * config_.sample_rate)),
-                             hrirs_.irs.front().left.size() + kFractionalTaps);
+  // Given a length, keep it (synthesize refuses a source whose direct sound it would cut);
+  // otherwise the longest RT60, and at least the direct sound of the paper grid's farthest source.
+  if (config_.length_s > 0.0)
+    length_ = static_cast<size_t>(std::ceil(config_.length_s * config_.sample_rate));
+  else
+    length_ = std::max(static_cast<size_t>(std::ceil(longest * config_.sample_rate)),
+                       direct_end(BrirGrid::paper().distances_m.back()));
   if (config_.late_tail) {
     // Diffuse-field level: image sources arrive at 4 pi c^3 t^2 / V per second with energy
     // E_hrir / (c t)^2 each, i.e. 4 pi c E_hrir / V per second, decaying by the RT60.
@@ -189,18 +280,47 @@ BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
         hrir_energy += 0.5 * (double(ir.left[i]) * ir.left[i] + double(ir.right[i]) * ir.right[i]);
     hrir_energy /= hrirs_.irs.size();
     const double c = config_.speed_of_sound;
-    const float level = static_cast<float>(
-        std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate)));
-    tail_.left = decaying_noise(length_, config_.sample_rate, band_rt60, config_.seed, 0);
-    tail_.right = decaying_noise(length_, config_.sample_rate, band_rt60, config_.seed, 1);
-    for (auto& x : tail_.left) x *= level;
-    for (auto& x : tail_.right) x *= level;
+    tail_level_ = std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate));
   }
+  band_rt60_ = std::move(band_rt60);
+}
+
+size_t BrirSynthesizer::direct_end(double distance_m) const {
+  return static_cast<size_t>(std::ceil(distance_m / config_.speed_of_sound * config_.sample_rate)) +
+         kFractionalTaps / 2 + hrirs_.irs.front().left.size();
+}
+
+// The late tail of one source from `start` on (faded in), its own noise per ear, ears balanced.
+BinauralIr BrirSynthesizer::late_tail(double azimuth_deg, double distance_m, size_t start) const {
+  const uint64_t stream = direction_stream(azimuth_deg, distance_m);
+  BinauralIr tail{decaying_noise(length_, config_.sample_rate, band_rt60_, config_.seed, stream),
+                  decaying_noise(length_, config_.sample_rate, band_rt60_, config_.seed, stream + 1)};
+  const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * config_.sample_rate));
+  auto window = [&](std::vector<float>& x) {
+    for (size_t i = 0; i < length_; ++i) {
+      const double t = i < start ? 0.0 : std::min(1.0, double(i - start) / fade);
+      x[i] *= static_cast<float>(tail_level_ * (0.5 - 0.5 * std::cos(kPi * t)));
+    }
+  };
+  window(tail.left);
+  window(tail.right);
+  balance_ears(tail.left, tail.right, config_.sample_rate);
+  for (size_t i = 0; i < std::min(start, length_); ++i) tail.left[i] = tail.right[i] = 0.0f;
+  return tail;
+}
+
+void BrirSynthesizer::check_source(double azimuth_deg, double distance_m) const {
+  if (!std::isfinite(azimuth_deg) || !std::isfinite(distance_m) || distance_m <= 0.05 ||
+      distance_m > kRoomBounds.max_side_m)
+    throw std::invalid_argument("BRIR synthesis: source azimuth/distance must be finite, in (0.05, 500] m");
+  if (direct_end(distance_m) > length_)
+    throw std::invalid_argument("BRIR synthesis: an IR of " + std::to_string(length_ / config_.sample_rate) +
+                                " s cuts off the direct sound of a source at " + std::to_string(distance_m) +
+                                " m (needs at least " + std::to_string(min_length_s(distance_m)) + " s)");
 }
 
 BinauralIr BrirSynthesizer::synthesize(double azimuth_deg, double distance_m) const {
-  if (!std::isfinite(azimuth_deg) || !std::isfinite(distance_m) || distance_m <= 0.05)
-    throw std::invalid_argument("BRIR synthesis: source azimuth/distance must be finite, > 0.05 m");
+  check_source(azimuth_deg, distance_m);
   const double heading = config_.listener_heading_deg * kPi / 180.0;
   const double world_angle = heading + azimuth_deg * kPi / 180.0;
   const Eigen::Vector3d source =
@@ -275,18 +395,17 @@ BinauralIr BrirSynthesizer::synthesize(double azimuth_deg, double distance_m) co
   }
   if (tail && std::isfinite(mixing_distance)) {
     const size_t start = static_cast<size_t>(std::ceil(mixing_distance / c * fs));
-    const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * fs));
+    const BinauralIr late = late_tail(azimuth_deg, distance_m, start);
     for (size_t i = start; i < length_; ++i) {
-      const double x = std::min(1.0, double(i - start) / fade);
-      const float w = static_cast<float>(0.5 - 0.5 * std::cos(kPi * x));
-      out.left[i] += w * tail_.left[i];
-      out.right[i] += w * tail_.right[i];
+      out.left[i] += late.left[i];
+      out.right[i] += late.right[i];
     }
   }
   return out;
 }
 
 BrirSet BrirSynthesizer::synthesize(const BrirGrid& grid) const {
+  for (double d : grid.distances_m) check_source(0.0, d);  // before any work
   const size_t na = grid.azimuths_deg.size(), nd = grid.distances_m.size();
   std::vector<BinauralIr> irs(na * nd);
   tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {

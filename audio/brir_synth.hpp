@@ -47,18 +47,33 @@ struct BrirSynthConfig {
   double speed_of_sound = 343.0;
   double wall_margin = 0.5;  // a source beyond a wall pushes that wall to this far behind it
   bool late_tail = true;
-  uint64_t seed = 1;  // tail noise (one stream per ear)
+  uint64_t seed = 1;  // tail noise (one stream per source direction and ear)
 };
 
-// Validates the config (room, listener inside, RT60 > 0, order >= 0, ...), throws
-// std::invalid_argument naming the offending value.
+// What a room may be. Outside these the image-source model stops describing a room a person
+// stands in (a 0.2 m box puts image sources a few centimetres from the ears, +40 dBFS before
+// normalisation; a 1e300 m one loses the listener's position to rounding), or the set would
+// not fit in memory (2400 responses of up to 3 s).
+struct RoomBounds {
+  double min_side_m = 1.0;
+  double max_side_m = 500.0;
+  double max_coordinate_m = 10000.0;   // corners within 10 km of the origin
+  double min_wall_distance_m = 0.25;   // listener to every wall, floor and ceiling
+  double max_rt60_s = 3.0;             // also the longest IR (--ir-length)
+};
+inline constexpr RoomBounds kRoomBounds{};
+
+// Validates the config (room within kRoomBounds, listener inside, RT60, order >= 0, ...),
+// throws std::invalid_argument naming the offending value.
 void validate(const BrirSynthConfig& config);
 
 // The listener position the config resolves to.
 Eigen::Vector3d listener_position(const BrirSynthConfig& config);
 
-// Synthesises BRIR sets for one room: the late tail is made once and shared (a diffuse field
-// does not depend on the source position).
+// Synthesises BRIR sets for one room. The late tail is noise of its own for every source
+// direction and ear (a shared tail would give every response the same spectral quirks and the
+// same left/right lean), balanced so both ears get the same energy in every twelfth of an
+// octave and every ~43 ms.
 class BrirSynthesizer {
  public:
   BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config);  // keeps its own copy
@@ -71,14 +86,26 @@ class BrirSynthesizer {
 
   size_t length() const { return length_; }
   double absorption() const { return absorption_; }
+  // std::invalid_argument unless the source is finite, in (0.05, 500] m and its direct sound
+  // fits in the IR length (synthesize checks this too).
+  void check_source(double azimuth_deg, double distance_m) const;
+  // The shortest IR length that holds the whole direct sound of a source this far away.
+  double min_length_s(double distance_m) const {
+    return double(direct_end(distance_m)) / config_.sample_rate;
+  }
 
  private:
+  size_t direct_end(double distance_m) const;  // samples
+
+  BinauralIr late_tail(double azimuth_deg, double distance_m, size_t start) const;
+
   HrirSet hrirs_;
   BrirSynthConfig config_;
   Eigen::Vector3d listener_;
   size_t length_ = 0;
   double absorption_ = 0.0;
-  BinauralIr tail_;  // decaying noise from t = 0, faded in per source at its mixing time
+  double tail_level_ = 0.0;        // diffuse-field amplitude at t = 0
+  std::vector<double> band_rt60_;  // per octave band
 };
 
 }  // namespace sonomap::audio

@@ -13,6 +13,7 @@ namespace sonomap::audio {
 
 const char* to_string(SoundKind kind) { return kind == SoundKind::Tap ? "tap" : "woosh"; }
 const char* to_string(SweepMode mode) { return mode == SweepMode::Ranging ? "ranging" : "objects"; }
+const char* to_string(LevelMode mode) { return mode == LevelMode::PerFile ? "per-file" : "fixed"; }
 
 double PitchMapping::semitones(double d) const {
   double shift = 0.0;
@@ -63,6 +64,11 @@ void SweepConfig::validate() const {
   require(std::isfinite(object_jump_m_per_deg) && object_jump_m_per_deg > 0.0,
           "object jump must be > 0 m per degree");
   require(max_objects >= 1, "max objects must be >= 1");
+  try {
+    loudness.validate();
+  } catch (const std::invalid_argument& e) {
+    require(false, e.what());
+  }
 }
 
 void validate_circle(const Circle& circle) {
@@ -120,17 +126,11 @@ double onset(const SweepConfig& c, int sector) {
 }
 
 double nearest_grid(const std::vector<double>& values, double x) {
-  double best = values.front();
-  for (double v : values)
-    if (std::abs(v - x) < std::abs(best - x) - 1e-9) best = v;
-  return best;
+  return values[nearest_distance_index(values, x)];
 }
 
 double nearest_grid_azimuth(const std::vector<double>& values, double az) {
-  double best = values.front();
-  for (double v : values)
-    if (std::abs(wrap_degrees_180(v - az)) < std::abs(wrap_degrees_180(best - az)) - 1e-9) best = v;
-  return best;
+  return values[nearest_azimuth_index(values, az)];
 }
 
 SweepEvent tap_event(const SweepConfig& c, const BrirGrid& grid, int sector, double azimuth,
@@ -266,6 +266,44 @@ std::vector<SweepEvent> SweepRenderer::schedule(const Circle& circle) const {
 SweepAudio SweepRenderer::render(const Circle& circle) { return render(schedule(circle)); }
 
 SweepAudio SweepRenderer::render(std::vector<SweepEvent> events) {
+  SweepAudio out = mix(std::move(events));
+  level(out);
+  return out;
+}
+
+std::vector<SweepEvent> SweepRenderer::loudest_events() const {
+  SweepConfig c = config_;
+  c.mode = SweepMode::Ranging;
+  c.filter = SweepFilter{};
+  Circle circle(360);
+  for (auto& b : circle.bins) b.range = 0.0f;  // clamped up to the nearest distance
+  return schedule_sweep(circle, c, brirs().grid());
+}
+
+void SweepRenderer::level(SweepAudio& out) {
+  const LoudnessRules& rules = config_.loudness;
+  const LoudnessMeasure raw = measure_loudness(out.left, out.right, out.sample_rate);
+  if (config_.level == LevelMode::PerFile) {
+    out.gain_db = loudness_gain_db(raw, rules);
+    out.peak_limited = peak_limited(raw, rules);
+  } else {
+    if (!fixed_gain_known_) {
+      const SweepAudio loudest = mix(loudest_events());
+      const LoudnessMeasure m = measure_loudness(loudest.left, loudest.right, loudest.sample_rate);
+      fixed_gain_db_ = loudness_gain_db(m, rules);
+      fixed_peak_limited_ = peak_limited(m, rules);
+      fixed_gain_known_ = true;
+    }
+    // The last line of defence: a sweep louder than the calibration one is turned down.
+    const double cap = rules.ceiling_dbtp - rules.margin_db - raw.true_peak_dbtp;
+    out.gain_db = std::min(fixed_gain_db_, cap);
+    out.peak_limited = fixed_peak_limited_ || cap < fixed_gain_db_;
+  }
+  apply_gain(out.left, out.right, out.gain_db);
+  out.loudness = with_gain(raw, out.gain_db);
+}
+
+SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events) {
   const BrirSet& set = brirs();
   const double fs = config_.sample_rate;
   // Indices of each event's BRIR and its first output sample.

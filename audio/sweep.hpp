@@ -8,6 +8,7 @@
 
 #include "audio/brir_set.hpp"
 #include "audio/convolver.hpp"
+#include "audio/loudness.hpp"
 #include "audio/sounds.hpp"
 #include "core/raster.hpp"
 
@@ -45,6 +46,14 @@ struct SweepFilter {
   bool in_window(double range_m) const;
 };
 
+// The level of a rendered sweep: one gain per file (loudness.hpp has the rule).
+//   PerFile: each sweep is normalised to the loudness target, the true-peak ceiling winning.
+//   Fixed:   one gain per renderer, set once from the loudest sweep its BRIR set can play (every
+//            sector a tap at the nearest distance) by the same rule, so that levels compare
+//            across sweeps; a sweep that would still pass the ceiling is turned down further.
+enum class LevelMode { PerFile, Fixed };
+const char* to_string(LevelMode mode);
+
 struct SweepConfig {
   SweepMode mode = SweepMode::Ranging;
   double sample_rate = 48000.0;
@@ -62,6 +71,8 @@ struct SweepConfig {
   int max_objects = 5;                 // objects mode: the N nearest pseudo-objects
   TapConfig tap;
   WooshConfig woosh;
+  LevelMode level = LevelMode::PerFile;
+  LoudnessRules loudness;
   void validate() const;  // throws std::invalid_argument naming the field
 };
 
@@ -81,6 +92,9 @@ struct SweepAudio {
   std::vector<float> left;
   std::vector<float> right;
   std::vector<SweepEvent> events;
+  double gain_db = 0.0;      // the one gain applied to the whole sweep
+  LoudnessMeasure loudness;  // of the output, gain included
+  bool peak_limited = false;  // the true-peak ceiling, not the loudness target, set the gain
 };
 
 // A pseudo-object: a run of known bins without a range jump, and its nearest point.
@@ -110,8 +124,11 @@ class SweepRenderer {
   const SweepConfig& config() const { return config_; }
   const BrirSet& brirs() const { return convolver_.brirs(); }
   std::vector<SweepEvent> schedule(const Circle& circle) const;
+  // Renders and levels the sweep (config().level).
   SweepAudio render(const Circle& circle);
   SweepAudio render(std::vector<SweepEvent> events);
+  // The loudest sweep the BRIR set can play: every sector a tap at the nearest distance.
+  std::vector<SweepEvent> loudest_events() const;
   // The dry sound an event plays (tap pitch variants are made once, at construction).
   const std::vector<float>& sound(SoundKind kind, double semitones) const;
   void clear_cache() { convolver_.clear_cache(); }
@@ -124,7 +141,12 @@ class SweepRenderer {
   };
   const Variant& variant(SoundKind kind, double semitones) const;
   size_t longest_sound() const;
+  SweepAudio mix(std::vector<SweepEvent> events);  // before any gain
+  void level(SweepAudio& audio);
 
+  double fixed_gain_db_ = 0.0;
+  bool fixed_gain_known_ = false;
+  bool fixed_peak_limited_ = false;
   SweepConfig config_;
   std::map<double, Variant> taps_;  // by pitch shift, semitones
   Variant woosh_;

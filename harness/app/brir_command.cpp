@@ -14,6 +14,7 @@ void add_brir_command(CLI::App& app, const GlobalOptions& global) {
   struct State {
     RoomOptions room;
     std::filesystem::path out;
+    SofaMetadata meta;
   };
   auto state = std::make_shared<State>();
   CLI::App* cmd = app.add_subcommand(
@@ -21,20 +22,29 @@ void add_brir_command(CLI::App& app, const GlobalOptions& global) {
               "(azimuth every 3 deg, 0.4..4.0 m) and write one SOFA file per distance");
   add_room_options(*cmd, state->room);
   cmd->add_option("--out", state->out, "Output directory (replaced atomically)")->required();
+  cmd->add_option("--author-contact", state->meta.author_contact,
+                  "AES69 AuthorContact written in every file")->capture_default_str();
+  cmd->add_option("--organization", state->meta.organization,
+                  "AES69 Organization written in every file")->capture_default_str();
   cmd->callback([state, &global] {
     const audio::BrirSynthConfig room = room_config(state->room, 48000.0);
     const audio::BrirSet set = synthesize_brirs(room, state->room.hrir_file, global.quiet);
     const Eigen::Vector3d lo = room.room.min_corner, hi = room.room.max_corner;
     const Eigen::Vector3d l = audio::listener_position(room);
-    char comment[512];
+    char comment[640];
     std::snprintf(comment, sizeof comment,
                   "shoebox room [%.2f,%.2f,%.2f]..[%.2f,%.2f,%.2f] m, listener (%.2f,%.2f,%.2f) "
-                  "heading %.1f deg, RT60 %.3f s, image-source order %d, HRIRs %s, tail seed %llu",
+                  "heading %.1f deg, RT60 %.3f s, image-source order %d, HRIRs %s, tail seed %llu; "
+                  "normalised: the loudest response has unit energy",
                   lo.x(), lo.y(), lo.z(), hi.x(), hi.y(), hi.z(), l.x(), l.y(), l.z(),
                   room.listener_heading_deg, room.rt60, room.max_order,
                   state->room.hrir_file.filename().string().c_str(), state->room.seed);
-    SofaMetadata meta;
+    SofaMetadata meta = state->meta;
     meta.comment = comment;
+    meta.room_min = lo;
+    meta.room_max = hi;
+    meta.listener = l;
+    meta.heading_deg = room.listener_heading_deg;
     write_brir_directory(state->out, set, meta);
     if (!global.quiet)
       std::fprintf(stderr, "wrote %zu SOFA files (%zu azimuths, %zu samples at %.0f Hz) to %s\n",

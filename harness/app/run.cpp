@@ -118,13 +118,21 @@ class SweepMaker {
       }
       renderer_ = std::make_unique<audio::SweepRenderer>(brirs, setup.sweep);
     }
-    write_sweep(renderer_->render(circle), wav);
+    const audio::SweepAudio audio = renderer_->render(circle);
+    write_sweep(audio, wav);
+    levels_.push_back({{"file", wav.filename().string()}, {"gain_db", audio.gain_db},
+                       {"loudness_lufs", audio.loudness.integrated_lufs},
+                       {"true_peak_dbtp", audio.loudness.true_peak_dbtp},
+                       {"peak_limited", audio.peak_limited}});
   }
+  // Per sweep written: the one gain applied and the measured loudness (summary.json "sweeps").
+  const json& levels() const { return levels_; }
 
  private:
   fs::path brir_dir_;
   bool quiet_;
   std::unique_ptr<audio::SweepRenderer> renderer_;
+  json levels_ = json::array();
 };
 
 }  // namespace
@@ -332,6 +340,7 @@ RunOutcome run_scenario(const RunOptions& options) {
   for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;
 
   json summary{{"scenario", {{"name", source->name()}, {"file", options.scenario.string()}}},
+               {"sweeps", sweeps.levels()},
                {"seed", source->seed()},
                {"code_version", code_version()},
                {"ground_truth", has_truth},

@@ -99,6 +99,11 @@ audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::pa
   const audio::HrirSet hrirs = read_hrir_set(hrir_file, room.sample_rate);
   const audio::BrirSynthesizer synth(hrirs, room);
   const audio::BrirGrid grid = audio::BrirGrid::paper();
+  try {
+    for (double d : grid.distances_m) synth.check_source(0.0, d);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("option --ir-length: ") + e.what());
+  }
   const size_t na = grid.azimuths_deg.size();
   std::vector<audio::BinauralIr> irs(na * grid.distances_m.size());
   Progress progress("BRIRs", static_cast<long>(irs.size()), quiet);
@@ -110,7 +115,9 @@ audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::pa
   });
   progress.update(done);
   progress.finish();
-  return audio::BrirSet(room.sample_rate, grid, std::move(irs));
+  audio::BrirSet set(room.sample_rate, grid, std::move(irs));
+  set.normalise_to_reference();
+  return set;
 }
 
 void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
@@ -151,6 +158,16 @@ void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
       ->capture_default_str();
   cmd.add_flag("--invert-pitch", w.pitch.inverted, "Near higher, far lower (parking sensor)");
   cmd.add_flag("!--no-woosh", w.woosh_unknown, "Unknown sectors stay silent");
+  cmd.add_option("--loudness", w.loudness.target_lufs,
+                 "Integrated loudness target, LUFS (EBU R128); the -1 dBTP true-peak ceiling wins")
+      ->capture_default_str();
+  cmd.add_option("--level", w.level,
+                 "per-file: each WAV normalised to --loudness; fixed: one gain for every sweep, "
+                 "set by the loudest sweep the BRIRs can play (levels compare across sweeps)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, audio::LevelMode>{{"per-file", audio::LevelMode::PerFile},
+                                                  {"fixed", audio::LevelMode::Fixed}}))
+      ->default_str("per-file");
 }
 
 void check_sweep_options(const SonifySetup& s) {
@@ -163,8 +180,11 @@ void check_sweep_options(const SonifySetup& s) {
 
 std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quiet) {
   const double rate = s.sweep.sample_rate;
-  if (!s.brir_dir.empty())
-    return std::make_shared<const audio::BrirSet>(read_brir_directory(s.brir_dir, rate));
+  if (!s.brir_dir.empty()) {
+    audio::BrirSet set = read_brir_directory(s.brir_dir, rate);
+    set.normalise_to_reference();
+    return std::make_shared<const audio::BrirSet>(std::move(set));
+  }
   const audio::BrirSynthConfig room = room_config(s.room, rate);
   if (!quiet) {
     const Eigen::Vector3d size = room.room.size();
@@ -177,16 +197,21 @@ std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quie
   return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet));
 }
 
-std::string sweep_events_csv(const std::vector<audio::SweepEvent>& events) {
+std::string sweep_events_csv(const audio::SweepAudio& audio) {
   std::string out =
-      "time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,pitch_semitones,sound\n";
-  char buf[256];
-  for (const auto& e : events) {
+      "time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,pitch_semitones,sound,"
+      "gain_db,loudness_lufs,true_peak_dbtp\n";
+  // The file's level, the same on every row: one gain for the whole sweep.
+  char level[96];
+  std::snprintf(level, sizeof level, "%.2f,%.2f,%.2f", audio.gain_db,
+                audio.loudness.integrated_lufs, audio.loudness.true_peak_dbtp);
+  char buf[320];
+  for (const auto& e : audio.events) {
     char range[32] = "";
     if (std::isfinite(e.range_m)) std::snprintf(range, sizeof range, "%.4f", e.range_m);
-    std::snprintf(buf, sizeof buf, "%.6f,%d,%.3f,%s,%.2f,%.1f,%.1f,%s\n", e.time_s, e.sector,
+    std::snprintf(buf, sizeof buf, "%.6f,%d,%.3f,%s,%.2f,%.1f,%.1f,%s,%s\n", e.time_s, e.sector,
                   e.azimuth_deg, range, e.brir_distance_m, e.brir_azimuth_deg, e.pitch_semitones,
-                  audio::to_string(e.sound));
+                  audio::to_string(e.sound), level);
     out += buf;
   }
   return out;
@@ -205,7 +230,7 @@ void write_sweep(const audio::SweepAudio& audio, const fs::path& wav) {
   {
     std::FILE* f = std::fopen(events_file.path().c_str(), "wb");
     if (!f) throw std::runtime_error("cannot write " + events_file.path().string());
-    const std::string text = sweep_events_csv(audio.events);
+    const std::string text = sweep_events_csv(audio);
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + events_file.path().string());
   }

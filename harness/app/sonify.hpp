@@ -61,11 +61,14 @@ void check_sweep_options(const SonifySetup& setup);
 std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& setup, bool quiet);
 
 // The event log: time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,
-// pitch_semitones,sound (range empty for a woosh).
-std::string sweep_events_csv(const std::vector<audio::SweepEvent>& events);
+// pitch_semitones,sound (range empty for a woosh), then the file's level on every row:
+// gain_db (the one gain applied), loudness_lufs (integrated, EBU R128; -inf when too short or
+// silent) and true_peak_dbtp (4x oversampled), both measured on the written signal.
+std::string sweep_events_csv(const audio::SweepAudio& audio);
 // "sweep.wav" -> "sweep.events.csv"
 std::filesystem::path events_path_for(const std::filesystem::path& wav);
 // Writes the WAV and its event CSV, each staged and renamed: no partial files on failure.
+// audio.gain_db / audio.loudness are the figures a run's summary carries.
 void write_sweep(const audio::SweepAudio& audio, const std::filesystem::path& wav);
 
 }  // namespace sonomap::harness

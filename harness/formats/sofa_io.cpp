@@ -5,10 +5,10 @@
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <map>
 #include <memory>
 #include <mysofa.h>
@@ -52,6 +52,36 @@ struct HrtfDeleter {
   throw InputError(file.string(), 0, "", what);
 }
 
+std::string attribute(const MYSOFA_HRTF& h, const char* name) {
+  const char* v = mysofa_getAttribute(h.attributes, const_cast<char*>(name));
+  return v ? v : "";
+}
+
+// What sonomap needs of a SingleRoomMIMOSRIR file (mysofa_check knows SimpleFreeFieldHRIR only):
+// impulse responses at two ears from one emitter per source, one listener with a view.
+int check_room_layout(const MYSOFA_HRTF& h) {
+  if (attribute(h, "DataType") != "FIR-E") return MYSOFA_INVALID_ATTRIBUTES;
+  if (h.C != 3 || h.I != 1 || h.E != 1 || h.R != 2) return MYSOFA_INVALID_DIMENSIONS;
+  for (const MYSOFA_ARRAY* a : {&h.ListenerPosition, &h.ListenerView})
+    if (!a->values || a->elements != 3) return MYSOFA_INVALID_FORMAT;
+  if (h.ListenerUp.values && h.ListenerUp.elements != 3) return MYSOFA_INVALID_FORMAT;
+  return MYSOFA_OK;
+}
+
+Eigen::Vector3d array3(const MYSOFA_ARRAY& a) { return {a.values[0], a.values[1], a.values[2]}; }
+
+// Rows: the listener's front, left and up axes in room coordinates (cartesian by now).
+Eigen::Matrix3d head_frame(const MYSOFA_HRTF& h) {
+  const Eigen::Vector3d up_hint = h.ListenerUp.values ? array3(h.ListenerUp) : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d front = array3(h.ListenerView).normalized();
+  const Eigen::Vector3d left = up_hint.cross(front).normalized();
+  Eigen::Matrix3d m;
+  m.row(0) = front;
+  m.row(1) = left;
+  m.row(2) = front.cross(left);
+  return m;  // NaN when view and up are parallel or zero
+}
+
 }  // namespace
 
 SofaContents read_sofa(const fs::path& file) {
@@ -60,7 +90,9 @@ SofaContents read_sofa(const fs::path& file) {
   int err = 0;
   std::unique_ptr<MYSOFA_HRTF, HrtfDeleter> hrtf(mysofa_load(file.c_str(), &err));
   if (!hrtf || err != MYSOFA_OK) bad(file, "libmysofa cannot load it: " + mysofa_error_name(err));
-  err = mysofa_check(hrtf.get());
+  const std::string conventions = attribute(*hrtf, "SOFAConventions");
+  const bool room = conventions == "SingleRoomMIMOSRIR";
+  err = room ? check_room_layout(*hrtf) : mysofa_check(hrtf.get());
   if (err != MYSOFA_OK) bad(file, "not a usable SOFA HRIR/BRIR file: " + mysofa_error_name(err));
   mysofa_tocartesian(hrtf.get());
 
@@ -93,13 +125,19 @@ SofaContents read_sofa(const fs::path& file) {
 
   SofaContents out;
   out.sample_rate = rate;
-  if (const char* room = mysofa_getAttribute(h.attributes, const_cast<char*>("RoomType")))
-    out.room_type = room;
+  out.conventions = conventions;
+  out.room_type = attribute(h, "RoomType");
+  for (const MYSOFA_ATTRIBUTE* a = h.attributes; a; a = a->next)
+    if (a->name) out.attributes[a->name] = a->value ? a->value : "";
+  const Eigen::Matrix3d to_head = room ? head_frame(h) : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d head = room ? array3(h.ListenerPosition) : Eigen::Vector3d::Zero();
+  if (!to_head.allFinite() || !head.allFinite())
+    bad(file, "ListenerPosition/ListenerView/ListenerUp do not give the head's position and axes");
   out.source_positions.reserve(m);
   out.irs.reserve(m);
   for (size_t i = 0; i < m; ++i) {
     const float* p = h.SourcePosition.values + 3 * i;
-    out.source_positions.emplace_back(p[0], p[1], p[2]);
+    out.source_positions.push_back(to_head * (Eigen::Vector3d(p[0], p[1], p[2]) - head));
     if (!out.source_positions.back().allFinite())
       bad(file, "SourcePosition of measurement " + std::to_string(i) + " is not finite");
     audio::BinauralIr ir{std::vector<float>(longest, 0.0f), std::vector<float>(longest, 0.0f)};
@@ -292,15 +330,6 @@ class NetcdfFile {
   int id_ = -1;
 };
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", &tm);
-  return buf;
-}
-
 }  // namespace
 
 std::string brir_file_name(double distance_m) {
@@ -309,6 +338,49 @@ std::string brir_file_name(double distance_m) {
   return buf;
 }
 
+namespace {
+
+// Head frame -> room frame: the listener's position plus the rotation by the heading.
+Eigen::Vector3d room_position(const SofaMetadata& meta, double azimuth_deg, double distance_m) {
+  const double a = (meta.heading_deg + azimuth_deg) * kPi / 180.0;
+  return meta.listener + distance_m * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0);
+}
+
+void write_globals(NetcdfFile& f, const SofaMetadata& meta) {
+  const std::pair<const char*, std::string> globals[] = {
+      {"Conventions", "SOFA"},
+      {"Version", "2.1"},
+      {"SOFAConventions", "SingleRoomMIMOSRIR"},
+      {"SOFAConventionsVersion", "1.0"},
+      {"DataType", "FIR-E"},
+      {"RoomType", "shoebox"},
+      {"Title", meta.title},
+      // Fixed dates: a file sonomap writes is the same bytes on every run.
+      {"DateCreated", "1970-01-01 00:00:00"},
+      {"DateModified", "1970-01-01 00:00:00"},
+      {"APIName", "sonomap"},
+      {"APIVersion", "0.1"},
+      {"AuthorContact", meta.author_contact},
+      {"Organization", meta.organization},
+      {"License", "GPL-3.0-or-later"},
+      {"ApplicationName", "sonomap brir"},
+      {"ApplicationVersion", "0.1"},
+      {"Comment", meta.comment},
+      {"History", "synthesised by the image-source method with a noise late tail"},
+      {"References", "Allen and Berkley 1979"},
+      {"Origin", "synthetic"},
+      {"DatabaseName", "sonomap"},
+      {"RoomDescription", "shoebox room of the image-source model"},
+      {"ListenerShortName", "KEMAR"},
+      {"ListenerDescription", "head of the HRIR set the responses were synthesised from"},
+      {"SourceDescription", "one source per measurement, on the listener's horizontal plane"}};
+  for (const auto& [name, value] : globals) f.text(NC_GLOBAL, name, value);
+}
+
+}  // namespace
+
+// AES69-2020 SingleRoomMIMOSRIR 1.0: one measurement per source position (M), two receivers
+// (the ears, R), one emitter per source (E), positions in room coordinates.
 static void write_sofa_file(const fs::path& path, double sample_rate, double distance_m,
                             const std::vector<double>& azimuths,
                             const std::vector<audio::BinauralIr>& irs, const SofaMetadata& meta) {
@@ -319,66 +391,59 @@ static void write_sofa_file(const fs::path& path, double sample_rate, double dis
     if (ir.left.size() != n || ir.right.size() != n || n == 0)
       throw std::invalid_argument("write SOFA: IRs of different lengths");
   NetcdfFile f(path);
-  const std::string now = utc_now();
-  const std::pair<const char*, std::string> globals[] = {
-      {"Conventions", "SOFA"},
-      {"Version", "1.0"},
-      {"SOFAConventions", "SimpleFreeFieldHRIR"},
-      {"SOFAConventionsVersion", "1.0"},
-      {"APIName", "sonomap"},
-      {"APIVersion", "0.1"},
-      {"ApplicationName", "sonomap brir"},
-      {"ApplicationVersion", "0.1"},
-      {"AuthorContact", ""},
-      {"Organization", ""},
-      {"License", "GPL-3.0-or-later"},
-      {"DataType", "FIR"},
-      {"RoomType", meta.room_type},
-      {"Title", meta.title},
-      {"Comment", meta.comment},
-      {"DateCreated", now},
-      {"DateModified", now},
-      {"ListenerShortName", "KEMAR"},
-      {"DatabaseName", "sonomap"},
-      {"History", "synthesised by the image-source method"},
-      {"References", "Allen and Berkley 1979"},
-      {"Origin", "synthetic"}};
-  for (const auto& [name, value] : globals) f.text(NC_GLOBAL, name, value);
+  write_globals(f, meta);
 
   const int I = f.dim("I", 1), C = f.dim("C", 3), R = f.dim("R", 2), E = f.dim("E", 1);
   const int N = f.dim("N", n), M = f.dim("M", m);
-  const int listener = f.variable("ListenerPosition", {I, C});
-  f.text(listener, "Type", "cartesian");
-  f.text(listener, "Units", "metre");
+  auto position = [&](const char* name, std::initializer_list<int> dims) {
+    const int v = f.variable(name, dims);
+    f.text(v, "Type", "cartesian");
+    f.text(v, "Units", "metre");
+    return v;
+  };
+  const int listener = position("ListenerPosition", {I, C});
+  const int view = position("ListenerView", {I, C});
   const int up = f.variable("ListenerUp", {I, C});
-  f.text(up, "Type", "cartesian");
-  f.text(up, "Units", "metre");
-  const int view = f.variable("ListenerView", {I, C});
-  f.text(view, "Type", "cartesian");
-  f.text(view, "Units", "metre");
-  const int receiver = f.variable("ReceiverPosition", {R, C, I});
-  f.text(receiver, "Type", "cartesian");
-  f.text(receiver, "Units", "metre");
-  const int source = f.variable("SourcePosition", {M, C});
-  f.text(source, "Type", "spherical");
-  f.text(source, "Units", "degree, degree, metre");
-  const int emitter = f.variable("EmitterPosition", {E, C, I});
-  f.text(emitter, "Type", "cartesian");
-  f.text(emitter, "Units", "metre");
-  const int ir = f.variable("Data.IR", {M, R, N});
+  const int receiver = position("ReceiverPosition", {R, C, I});
+  const int source = position("SourcePosition", {M, C});
+  const int source_view = position("SourceView", {M, C});
+  const int source_up = f.variable("SourceUp", {I, C});
+  const int emitter = position("EmitterPosition", {E, C, I});
+  const bool has_room = meta.room_min.allFinite() && meta.room_max.allFinite();
+  int corner_a = -1, corner_b = -1;
+  if (has_room) {
+    const int corners = f.variable("RoomCorners", {I});
+    f.text(corners, "Type", "cartesian");
+    f.text(corners, "Units", "metre");
+    corner_a = f.variable("RoomCornerA", {I, C});
+    corner_b = f.variable("RoomCornerB", {I, C});
+  }
+  const int ir = f.variable("Data.IR", {M, R, N, E});
   const int rate = f.variable("Data.SamplingRate", {I});
   f.text(rate, "Units", "hertz");
-  const int delay = f.variable("Data.Delay", {I, R});
+  const int delay = f.variable("Data.Delay", {I, R, E});
   f.check(nc_enddef(f.id()), "end of definitions");
 
-  f.put(listener, {0, 0, 0});
+  const Eigen::Vector3d l = meta.listener;
+  const double h = meta.heading_deg * kPi / 180.0;
+  f.put(listener, {l.x(), l.y(), l.z()});
+  f.put(view, {std::cos(h), std::sin(h), 0});
   f.put(up, {0, 0, 1});
-  f.put(view, {1, 0, 0});
-  f.put(receiver, {0, 0.09, 0, 0, -0.09, 0});  // left ear +y, right ear -y
-  std::vector<double> positions;
-  for (double a : azimuths) positions.insert(positions.end(), {a, 0.0, distance_m});
+  f.put(receiver, {0, 0.09, 0, 0, -0.09, 0});  // left ear +y, right ear -y (listener frame)
+  std::vector<double> positions, views;
+  for (double a : azimuths) {
+    const Eigen::Vector3d p = room_position(meta, a, distance_m), towards = (l - p).normalized();
+    positions.insert(positions.end(), {p.x(), p.y(), p.z()});
+    views.insert(views.end(), {towards.x(), towards.y(), towards.z()});  // facing the head
+  }
   f.put(source, positions);
+  f.put(source_view, views);
+  f.put(source_up, {0, 0, 1});
   f.put(emitter, {0, 0, 0});
+  if (has_room) {
+    f.put(corner_a, {meta.room_min.x(), meta.room_min.y(), meta.room_min.z()});
+    f.put(corner_b, {meta.room_max.x(), meta.room_max.y(), meta.room_max.z()});
+  }
   std::vector<double> data;
   data.reserve(m * 2 * n);
   for (const auto& pair : irs) {

@@ -3,14 +3,18 @@
 // Reading uses libmysofa's low-level path (mysofa_load + mysofa_check): no loudness
 // normalisation and no interpolation; every measured IR is taken as stored (Data.Delay applied
 // as whole samples) and resampled to the output rate with libsamplerate when the file's differs.
-// Writing uses the netCDF-4 C API in the layout libmysofa 1.3.1 loads: SimpleFreeFieldHRIR with
-// RoomType "reverberant", Data.IR contiguous and uncompressed, Data.Delay present.
+// Writing uses the netCDF-4 C API, AES69's convention for room responses, SingleRoomMIMOSRIR 1.0
+// (DataType FIR-E, RoomType shoebox, positions in room coordinates), in the layout libmysofa
+// 1.3.1 loads: Data.IR contiguous and uncompressed, Data.Delay present, no timestamps.
+// Read back: SimpleFreeFieldHRIR (checked by mysofa_check) or SingleRoomMIMOSRIR (checked
+// here: two ears, one emitter), source positions turned into the listener's head frame.
 // Bad files raise InputError naming the file.
 #pragma once
 
 #include "audio/brir_set.hpp"
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,12 +23,14 @@ namespace sonomap::harness {
 // One SOFA file as stored: measurement positions (cartesian, head frame) and binaural IRs.
 struct SofaContents {
   double sample_rate = 0.0;
-  std::vector<Eigen::Vector3d> source_positions;  // metres, x front, y left, z up
+  std::vector<Eigen::Vector3d> source_positions;  // metres, head frame: x front, y left, z up
   std::vector<audio::BinauralIr> irs;
+  std::string conventions;  // SOFAConventions
   std::string room_type;
+  std::map<std::string, std::string> attributes;  // every global attribute, as stored
 };
 
-// Reads any SimpleFreeFieldHRIR file libmysofa accepts. No resampling.
+// Reads a SimpleFreeFieldHRIR or SingleRoomMIMOSRIR file libmysofa loads. No resampling.
 SofaContents read_sofa(const std::filesystem::path& file);
 
 // An HRIR set for synthesis, resampled to `output_rate`.
@@ -38,10 +44,18 @@ audio::BrirSet read_brir_directory(const std::filesystem::path& directory, doubl
                                    const std::vector<double>& required_distances_m =
                                        audio::BrirGrid::paper().distances_m);
 
+// What a written BRIR file says besides its responses (AES69 attributes and positions).
 struct SofaMetadata {
   std::string title = "sonomap synthetic BRIR";
   std::string comment;
-  std::string room_type = "reverberant";
+  std::string author_contact = "whoever ran sonomap brir (generated file)";
+  std::string organization = "sonomap";
+  // The room (RoomCornerA/B; not written when NaN) and the head in it, facing heading_deg
+  // from +x: source positions are written in these room coordinates.
+  Eigen::Vector3d room_min = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d room_max = Eigen::Vector3d::Constant(NAN);
+  Eigen::Vector3d listener = Eigen::Vector3d::Zero();
+  double heading_deg = 0.0;
 };
 
 // Writes one SOFA file: measurements from `azimuths_deg` (elevation 0) at `distance_m`.

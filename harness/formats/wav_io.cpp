@@ -18,8 +18,17 @@ void write_wav(const std::filesystem::path& path, double sample_rate, const std:
   info.samplerate = static_cast<int>(std::lround(sample_rate));
   info.channels = 2;
   info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+  // The last line of defence of the loudness rules (audio/loudness.hpp): nothing above the
+  // ceiling is ever written, whatever computed it.
+  for (const auto* channel : {&left, &right})
+    for (float x : *channel)
+      if (!(std::abs(x) <= kWavCeiling))
+        throw std::logic_error(path.string() + ": refusing to write a sample of " +
+                               std::to_string(x) + " (above -1 dBFS, or not finite)");
   SNDFILE* f = sf_open(path.c_str(), SFM_WRITE, &info);
   if (!f) throw std::runtime_error(path.string() + ": cannot write WAV: " + sf_strerror(nullptr));
+  // libsndfile's PEAK chunk carries a timestamp: without it two renders are byte-identical.
+  sf_command(f, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
   std::vector<float> frames(left.size() * 2);
   for (size_t i = 0; i < left.size(); ++i) {
     frames[2 * i] = left[i];

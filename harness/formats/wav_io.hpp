@@ -13,7 +13,12 @@ struct StereoAudio {
   std::vector<float> right;
 };
 
-// Writes a stereo 32-bit float WAV at `path` directly (callers stage it: see StagedFile).
+// -1 dBFS: no sample sonomap writes is larger in magnitude.
+constexpr float kWavCeiling = 0.891250908f;  // the float just below 10^(-1/20)
+
+// Writes a stereo 32-bit float WAV at `path` directly (callers stage it: see StagedFile), with
+// no PEAK chunk (it holds a timestamp). std::logic_error, and nothing written, if a sample is
+// above kWavCeiling or not finite: the caller's level rules failed.
 void write_wav(const std::filesystem::path& path, double sample_rate, const std::vector<float>& left,
                const std::vector<float>& right);
 

@@ -177,7 +177,34 @@ TEST_CASE("bad room configurations are refused with a clear error", "[room]") {
   config = {};
   config.max_order = -1;
   CHECK_THROWS_AS(validate(config), std::invalid_argument);
+  config = {};
+  config.room.max_corner = {0.2, 0.2, 0.2};  // image sources centimetres from the ears
+  CHECK_THROWS_WITH(validate(config), Catch::Contains("room sides"));
+  config.room.max_corner = {1e300, 4.0, 3.0};  // the listener's position lost to rounding
+  CHECK_THROWS_WITH(validate(config), Catch::Contains("room corners"));
+  config = {};
+  config.listener = {0.1, 2.0, 1.5};
+  CHECK_THROWS_WITH(validate(config), Catch::Contains("0.25 m from every wall"));
+  config = {};
+  config.rt60 = 20.0;
+  CHECK_THROWS_WITH(validate(config), Catch::Contains("rt60"));
   HrirSet h = omni_hrirs();
   h.sample_rate = 44100.0;
   CHECK_THROWS_WITH(BrirSynthesizer(h, BrirSynthConfig{}), Catch::Contains("resample"));
+}
+
+TEST_CASE("an IR too short for the direct sound is refused, not rendered silent", "[room]") {
+  BrirSynthConfig config;
+  config.length_s = 0.005;  // 240 samples: a source 2 m away arrives after 280
+  const BrirSynthesizer synth(omni_hrirs(), config);
+  CHECK_NOTHROW(synth.synthesize(0.0, 0.4));  // 56 + 8 + 32 samples fit
+  CHECK_THROWS_WITH(synth.synthesize(0.0, 2.0), Catch::Contains("direct sound"));
+  CHECK_THROWS_WITH(synth.synthesize(BrirGrid::paper()), Catch::Contains("direct sound"));
+  CHECK(synth.min_length_s(2.0) == Approx((std::ceil(2.0 / kC * kFs) + 8 + 32) / kFs));
+  // Without a length, the IR holds the farthest grid distance whatever the RT60.
+  config.length_s = 0.0;
+  config.rt60 = 0.02;
+  config.room.max_corner = {1.0, 1.0, 1.0};
+  const BrirSynthesizer short_room(omni_hrirs(), config);
+  CHECK_NOTHROW(short_room.synthesize(0.0, 4.0));
 }

@@ -307,3 +307,29 @@ TEST_CASE("rendering is deterministic and independent of the thread count", "[sw
   CHECK(one.left == two.left);
   CHECK(one.right == two.right);
 }
+
+TEST_CASE("a range plays the nearest grid distance: exactly on a grid value that value, a "
+          "midpoint the larger one",
+          "[sweep]") {
+  // A grid with 1.0 m, as float SOFA files give it (1.0f, 0.5f are exact; 1.5 via float).
+  const std::vector<double> half_metres{0.5, double(1.0f), double(1.5f), 2.0};
+  CHECK(nearest_distance_index(half_metres, 1.0) == 1);
+  CHECK(nearest_distance_index(half_metres, 0.76) == 1);
+  CHECK(nearest_distance_index(half_metres, 0.74) == 0);
+  // The paper's grid (0.4 m steps, built as sums): 1.0 m is halfway between 0.8 and 1.2.
+  const BrirGrid paper = BrirGrid::paper();
+  CHECK(paper.distances_m[nearest_distance_index(paper.distances_m, 1.0)] == Approx(1.2));
+  CHECK(paper.distances_m[nearest_distance_index(paper.distances_m, 0.99)] == Approx(0.8));
+  CHECK(paper.distances_m[nearest_distance_index(paper.distances_m, 1.2)] == Approx(1.2));
+  // The same grid read back from float files: 0.8f and 1.2f are not 0.8 and 1.2.
+  std::vector<double> from_floats;
+  for (double d : paper.distances_m) from_floats.push_back(double(float(d)));
+  CHECK(from_floats[nearest_distance_index(from_floats, 1.0)] == Approx(1.2));
+  // The schedule and the renderer agree: a tap at exactly 1.0 m on a 0.5 m grid uses 1.0 m.
+  BrirGrid grid = paper;
+  grid.distances_m = half_metres;
+  SweepConfig config;
+  const auto events = schedule_sweep(circle_with({{5, 1.0f}}), config, grid);
+  REQUIRE(!events.empty());
+  CHECK(events.front().brir_distance_m == 1.0);
+}

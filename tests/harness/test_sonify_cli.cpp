@@ -5,6 +5,7 @@
 #include "harness/formats/sofa_io.hpp"
 #include "harness/formats/wav_io.hpp"
 #include "harness/support/errors.hpp"
+#include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include <catch2/catch.hpp>
@@ -145,7 +146,7 @@ TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a
           "[cli][brir]") {
   const sonomap::test::ScratchDir scratch("sonify-brir");
   const fs::path& dir = scratch.path();
-  Result r = run("-q brir --room 5x4x3 --rt60 0.2 --order 0 --ir-length 0.02 --out " +
+  Result r = run("-q brir --room 5x4x3 --rt60 0.2 --order 0 --ir-length 0.03 --out " +
                      (dir / "set").string(),
                  dir);
   INFO(r.err);
@@ -154,7 +155,7 @@ TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a
   CHECK(set.azimuth_count() == 120);
   CHECK(set.distance_count() == 10);
   CHECK(set.grid().azimuths_deg.front() == Approx(-177.0));
-  CHECK(set.ir_length() == 960);
+  CHECK(set.ir_length() == 1440);
 
   r = run("-q brir --room 5x4x3 --listener 9,1,1 --out " + (dir / "bad").string(), dir);
   CHECK(r.status == 2);
@@ -163,10 +164,62 @@ TEST_CASE("brir writes the paper's grid that sonify then loads, without --brir a
 
   std::ofstream(dir / "circle.csv") << circle_text(360, "2.0");
   r = run("sonify " + (dir / "circle.csv").string() + " --out " + (dir / "sweep.wav").string() +
-              " --rt60 0.2 --order 0 --ir-length 0.02 --mode objects",
+              " --rt60 0.2 --order 0 --ir-length 0.03 --mode objects",
           dir);
   CHECK(r.status == 0);
   CHECK_THAT(r.err, Catch::Contains("synthesising BRIRs"));
   CHECK(fs::exists(dir / "sweep.wav"));
   fs::remove_all(dir);
+}
+
+
+TEST_CASE("two renders of a sweep are byte-identical, WAV and events", "[cli][sonify]") {
+  const sonomap::test::ScratchDir scratch("sonify-twice");
+  const fs::path& dir = scratch.path();
+  write_impulse_brirs(dir / "brirs");
+  std::ofstream(dir / "circle.csv") << circle_text(360, "0.8");
+  for (const char* name : {"a.wav", "b.wav"}) {
+    const Result r = run("-q sonify " + (dir / "circle.csv").string() + " --out " +
+                             (dir / name).string() + " --brir " + (dir / "brirs").string(),
+                         dir);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    if (std::string(name) == "a.wav") sleep(1);  // a timestamp in the file would differ
+  }
+  using sonomap::test::text_of;
+  CHECK(text_of(dir / "a.wav").size() > 44);
+  CHECK(text_of(dir / "a.wav") == text_of(dir / "b.wav"));
+  CHECK(text_of(dir / "a.events.csv") == text_of(dir / "b.events.csv"));
+  CHECK(text_of(dir / "a.wav").find("PEAK") == std::string::npos);
+}
+
+TEST_CASE("absurd rooms and an IR shorter than the direct sound are refused: exit 2, nothing "
+          "written",
+          "[cli][brir]") {
+  const sonomap::test::ScratchDir scratch("brir-bounds");
+  const fs::path& dir = scratch.path();
+  const std::string out = " --out " + (dir / "set").string();
+  Result r = run("-q brir --room 1e300x4x3" + out, dir);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Catch::Contains("room"));
+  r = run("-q brir --room 0.2x0.2x0.2" + out, dir);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Catch::Contains("room sides must be in [1, 500] m"));
+  r = run("-q brir --room 5x4x3 --listener 0.1,2,1.5" + out, dir);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Catch::Contains("0.25 m from every wall"));
+  r = run("-q brir --rt60 30" + out, dir);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Catch::Contains("rt60 must be in (0.01, 3] s"));
+  // 4 m at 343 m/s is 11.7 ms before the HRIR even starts: 10 ms cannot hold it.
+  r = run("-q brir --ir-length 0.01" + out, dir);
+  CHECK(r.status == 2);
+  CHECK_THAT(r.err, Catch::Contains("--ir-length") && Catch::Contains("direct sound"));
+  CHECK(!fs::exists(dir / "set"));
+  std::ofstream(dir / "circle.csv") << circle_text(360, "1.0");
+  r = run("-q sonify " + (dir / "circle.csv").string() + " --room 0.2x0.2x0.2 --out " +
+              (dir / "sweep.wav").string(),
+          dir);
+  CHECK(r.status == 2);
+  CHECK(!fs::exists(dir / "sweep.wav"));
 }
