@@ -250,7 +250,8 @@ RosbagWriter::RosbagWriter(const fs::path& file) : impl_(std::make_unique<Impl>(
 RosbagWriter::~RosbagWriter() = default;
 
 void RosbagWriter::depth(const std::string& topic, double stamp, const std::string& frame_id, int width,
-                         int height, const std::vector<float>& metres, double units_per_metre) {
+                         int height, const std::vector<float>& metres, double units_per_metre,
+                         double received) {
   sensor_msgs::Image image;
   image.header.stamp = ros::Time(stamp);
   image.header.frame_id = frame_id;
@@ -273,7 +274,7 @@ void RosbagWriter::depth(const std::string& topic, double stamp, const std::stri
     image.data.resize(metres.size() * 4);
     std::memcpy(image.data.data(), metres.data(), image.data.size());
   }
-  impl_->bag.write(topic, image.header.stamp, image);
+  impl_->bag.write(topic, received > 0.0 ? ros::Time(received) : image.header.stamp, image);
 }
 
 void RosbagWriter::camera_info(const std::string& topic, double stamp, const std::string& frame_id,

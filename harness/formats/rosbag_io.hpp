@@ -30,9 +30,11 @@ class RosbagWriter {
   RosbagWriter& operator=(const RosbagWriter&) = delete;
 
   // sensor_msgs/Image: depth in metres as 32FC1, or as 16UC1 units of 1/units_per_metre
-  // (rounded; a depth 16 bits cannot hold becomes 0).
+  // (rounded; a depth 16 bits cannot hold becomes 0). `received`: the bag's record time (a
+  // bag is ordered by it), 0 for the stamp.
   void depth(const std::string& topic, double stamp, const std::string& frame_id, int width,
-             int height, const std::vector<float>& metres, double units_per_metre = 0.0);
+             int height, const std::vector<float>& metres, double units_per_metre = 0.0,
+             double received = 0.0);
   void camera_info(const std::string& topic, double stamp, const std::string& frame_id,
                    const sim::CameraSpec& camera);
   void transform(const std::string& topic, double stamp, const std::string& parent,
