@@ -104,36 +104,28 @@ TEST_CASE("bad folder sequences fail with file, line and key, and write nothing"
   const fs::path sequence = scratch.path() / "sequence.yaml";
   const fs::path out = scratch.path() / "out";
 
+  // The run exits 2 and its message holds every one of `parts`.
+  const auto fails_with = [&](const std::string& text, const std::vector<std::string>& parts) {
+    write_text(sequence, text);
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    for (const auto& part : parts) CHECK_THAT(result.output, Catch::Contains(part));
+  };
   SECTION("every missing file is named at once") {
-    write_text(sequence, sequence_text(scratch.path(), "1000"));
     fs::remove(scratch.path() / "seven/frame-000002.depth.png");
     fs::remove(scratch.path() / "seven/frame-000004.pose.txt");
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("2 files missing"));
-    CHECK_THAT(result.output, Catch::Contains("frame-000002.depth.png"));
-    CHECK_THAT(result.output, Catch::Contains("frame-000004.pose.txt"));
+    fails_with(sequence_text(scratch.path(), "1000"),
+               {"2 files missing", "frame-000002.depth.png", "frame-000004.pose.txt"});
   }
   SECTION("a forgotten depth scale is an error with the hint") {
-    write_text(sequence, sequence_text(scratch.path(), ""));
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("sequence.depth.scale"));
-    CHECK_THAT(result.output, Catch::Contains("millimetre PNGs: 1000"));
+    fails_with(sequence_text(scratch.path(), ""), {"sequence.depth.scale", "millimetre PNGs: 1000"});
   }
   SECTION("millimetres read as metres give an implausible median depth") {
-    write_text(sequence, sequence_text(scratch.path(), "1"));
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("median depth"));
-    CHECK_THAT(result.output, Catch::Contains("check depth.scale"));
+    fails_with(sequence_text(scratch.path(), "1"), {"median depth", "check depth.scale"});
   }
   SECTION("a number out of range names its line and key") {
-    write_text(sequence, sequence_text(scratch.path(), "1000", "-5"));
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("sequence.yaml:10"));
-    CHECK_THAT(result.output, Catch::Contains("sequence.camera.intrinsics.fx"));
+    fails_with(sequence_text(scratch.path(), "1000", "-5"),
+               {"sequence.yaml:10", "sequence.camera.intrinsics.fx"});
   }
   CHECK(test::nothing_written(out));
 }
