@@ -2,7 +2,7 @@
 #include "harness/app/frame_source.hpp"
 
 #include "harness/formats/scenario_yaml.hpp"
-#include "harness/formats/tum_io.hpp"
+#include "harness/formats/sequence_io.hpp"
 #include "harness/support/errors.hpp"
 #include "sim/simulation.hpp"
 
@@ -37,26 +37,23 @@ class SimulatedSource final : public FrameSource {
   std::unique_ptr<sim::Simulation> simulation_;
 };
 
-// A recorded sequence (depth.txt, groundtruth.txt, depth/*.png, camera.yaml): its poses are
-// what a localisation system gave; the ground is the world's z = 0 plane (as TUM's and ours).
+// A recording (a TUM RGB-D folder or a sequence file): its poses are what a localisation
+// system gave, its world turned z-up with the floor where the sequence file puts it.
 class RecordedSource final : public FrameSource {
  public:
-  RecordedSource(const fs::path& dir, int frames) : sequence_(read_tum_sequence(dir)) {
-    if (sequence_.frames.empty()) throw InputError(dir.string() + ": the sequence has no frame with a pose");
-    count_ = static_cast<int>(sequence_.frames.size());
+  RecordedSource(const fs::path& input, int frames) : sequence_(open_recorded_sequence(input)) {
+    count_ = sequence_->frame_count();
     if (frames > 0) count_ = std::min(count_, frames);
   }
-  std::string name() const override {
-    return sequence_.camera.name.empty() ? sequence_.dir.filename().string() : sequence_.camera.name;
-  }
+  std::string name() const override { return sequence_->name(); }
   int frame_count() const override { return count_; }
-  Frame frame(int i) override { return load_tum_frame(sequence_, static_cast<std::size_t>(i)); }
-  double ground_z() const override { return 0.0; }
+  Frame frame(int i) override { return sequence_->frame(i); }
+  double ground_z() const override { return sequence_->ground_z(); }
   std::uint64_t seed() const override { return 0; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }
 
  private:
-  TumSequence sequence_;
+  std::unique_ptr<RecordedSequence> sequence_;
   int count_ = 0;
 };
 
@@ -65,7 +62,7 @@ class RecordedSource final : public FrameSource {
 std::unique_ptr<FrameSource> open_frame_source(const fs::path& input,
                                                std::vector<std::string> overrides, int frames,
                                                std::optional<std::uint64_t> seed) {
-  if (fs::is_directory(input)) {
+  if (fs::is_directory(input) || is_sequence_file(input)) {
     if (!overrides.empty())
       throw InputError("--set " + overrides.front() +
                        ": a recorded sequence has no scenario keys (only run keys apply)");

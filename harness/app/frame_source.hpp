@@ -27,8 +27,9 @@ class FrameSource {
   virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
 };
 
-// The frame source a run's input names: a directory is a recorded TUM RGB-D sequence (its
-// first `frames` frames; 0: all), anything else a scenario YAML file loaded with `overrides`
+// The frame source a run's input names: a directory (a recorded TUM RGB-D sequence) or a
+// sequence file (sequence.yaml, or a top-level `sequence:` key) is a recording (its first
+// `frames` frames; 0: all), anything else a scenario YAML file loaded with `overrides`
 // (its frame count set by `frames` > 0 and its seed by `seed`).
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& input,
                                                std::vector<std::string> overrides, int frames,

@@ -432,8 +432,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
       "run", "Run a scenario through the whole chain (sensor, mapper, rasters, ground truth, "
              "metrics, pictures, sweeps) and write one result directory");
   cmd->add_option("scenario", options->scenario,
-                  "Scenario YAML file, or a recorded TUM RGB-D directory (depth.txt, groundtruth.txt,\n"
-                  "depth/*.png, camera.yaml: no ground truth, no metrics)")->required();
+                  "Scenario YAML file, a recorded TUM RGB-D directory (depth.txt, groundtruth.txt,\n"
+                  "depth/*.png, camera.yaml), or a sequence file (sequence.yaml: a folder of depth\n"
+                  "PNGs or a ROS1 bag; docs/real-data.md). Recordings: no ground truth, no metrics")->required();
   cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
   cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
       ->check(CLI::PositiveNumber);

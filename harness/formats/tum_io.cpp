@@ -295,9 +295,9 @@ TumSequence read_tum_sequence(const fs::path& dir, double max_time_difference) {
   return sequence;
 }
 
-Frame load_tum_frame(const TumSequence& sequence, std::size_t i) {
+DepthRecord read_tum_record(const TumSequence& sequence, std::size_t i) {
   if (i >= sequence.frames.size())
-    throw std::out_of_range("load_tum_frame: frame " + std::to_string(i) + " of " +
+    throw std::out_of_range("read_tum_record: frame " + std::to_string(i) + " of " +
                             std::to_string(sequence.frames.size()));
   const TumFrameInfo& info = sequence.frames[i];
   const sim::CameraSpec& camera = sequence.camera.camera;
@@ -307,28 +307,18 @@ Frame load_tum_frame(const TumSequence& sequence, std::size_t i) {
                      "the image is " + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + " but camera.yaml says " +
                          std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  Frame frame;
-  frame.index = static_cast<int>(i);
-  frame.time = info.timestamp - sequence.frames.front().timestamp;
-  frame.width = image.width;
-  frame.height = image.height;
-  frame.depth.resize(image.pixels.size(), 0.0f);
-  for (int v = 0; v < image.height; ++v) {
-    for (int u = 0; u < image.width; ++u) {
-      const std::size_t k = static_cast<std::size_t>(v) * image.width + u;
-      const double z = image.pixels[k] / sequence.camera.depth_scale;
-      if (image.pixels[k] == 0 || z < camera.min_range || z > camera.max_range) continue;
-      frame.depth[k] = static_cast<float>(z);
-      frame.points_camera.emplace_back(static_cast<float>((u - camera.cx) * z / camera.fx),
-                                       static_cast<float>((v - camera.cy) * z / camera.fy),
-                                       static_cast<float>(z));
-    }
-  }
-  frame.world_T_camera = info.world_T_camera;
-  frame.world_T_camera_true = info.world_T_camera;
-  frame.world_T_body = info.world_T_camera * camera.body_T_camera.inverse();
-  frame.world_T_body_true = frame.world_T_body;
-  return frame;
+  DepthRecord record;
+  record.time = info.timestamp;
+  record.width = image.width;
+  record.height = image.height;
+  record.depth = depth_from_units(image.pixels, sequence.camera.depth_scale);
+  record.world_T_camera = info.world_T_camera;
+  return record;
+}
+
+Frame load_tum_frame(const TumSequence& sequence, std::size_t i) {
+  return frame_from_record(static_cast<int>(i), read_tum_record(sequence, i),
+                           sequence.frames.front().timestamp, sequence.camera.camera);
 }
 
 }  // namespace sonomap::harness

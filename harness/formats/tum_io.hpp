@@ -9,6 +9,7 @@
 
 #include "core/types.hpp"
 #include "harness/formats/scenario_yaml.hpp"
+#include "harness/formats/sequence_frame.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -65,6 +66,9 @@ struct TumSequence {
 // a pose. Depth images are read lazily by load_tum_frame.
 TumSequence read_tum_sequence(const std::filesystem::path& dir,
                               double max_time_difference = 0.02);
+
+// Frame i's depth image in metres and its pose (the recording's clock).
+DepthRecord read_tum_record(const TumSequence& sequence, std::size_t i);
 
 // Frame i as the mapper sees it: z-depth in metres (0 outside [min_range, max_range]), the
 // back-projected points, and the poses (the recorded pose is both "given" and "true"; the

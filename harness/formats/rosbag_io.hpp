@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// ROS1 bags in and out, with Debian's rosbag_storage. Reading streams the depth topic one
+// message at a time (never the whole bag); the pose topic (small messages) is read at open.
+// ROS types stay inside rosbag_io.cpp: nothing else includes a ROS header.
+#pragma once
+
+#include "harness/formats/sequence_io.hpp"
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sonomap::harness {
+
+// The bag reader of a sequence file's ros1_bag source: depth (sensor_msgs/Image, 16UC1 or
+// 32FC1), intrinsics (given, or the first sensor_msgs/CameraInfo on camera.info_topic), poses
+// (geometry_msgs/TransformStamped or PoseStamped), each depth frame taking the pose nearest in
+// header time (or interpolated) within time.tolerance. Throws InputError naming the bag, the
+// topic and the message index for a truncated bag, a missing topic, a wrong message type,
+// stamps out of order, or a frame with no pose.
+std::unique_ptr<RecordReader> open_rosbag_reader(const SequenceSpec& spec);
+
+// Writes a ROS1 bag (create or replace `file`). Stamps are seconds (> 0).
+class RosbagWriter {
+ public:
+  explicit RosbagWriter(const std::filesystem::path& file);
+  ~RosbagWriter();
+  RosbagWriter(const RosbagWriter&) = delete;
+  RosbagWriter& operator=(const RosbagWriter&) = delete;
+
+  // sensor_msgs/Image: depth in metres as 32FC1, or as 16UC1 units of 1/units_per_metre
+  // (rounded; a depth 16 bits cannot hold becomes 0). `received`: the bag's record time (a
+  // bag is ordered by it), 0 for the stamp.
+  void depth(const std::string& topic, double stamp, const std::string& frame_id, int width,
+             int height, const std::vector<float>& metres, double units_per_metre = 0.0,
+             double received = 0.0);
+  void camera_info(const std::string& topic, double stamp, const std::string& frame_id,
+                   const sim::CameraSpec& camera);
+  void transform(const std::string& topic, double stamp, const std::string& parent,
+                 const std::string& child, const Eigen::Isometry3d& parent_T_child);
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sonomap::harness
