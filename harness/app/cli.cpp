@@ -38,6 +38,7 @@ int run_cli(int argc, char** argv) {
   add_bench_command(app, global);
   add_score_command(app, global);
   add_diff_command(app, global);
+  add_keys_command(app, global);
 
   try {
     app.parse(argc, argv);

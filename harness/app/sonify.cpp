@@ -4,6 +4,7 @@
 #include "harness/formats/sofa_io.hpp"
 #include "harness/formats/wav_io.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/fields.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
 
@@ -38,11 +39,12 @@ void add_room_options(CLI::App& cmd, RoomOptions& o) {
       ->capture_default_str();
 }
 
-static double parse_number(const std::string& text, const std::string& option) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v))
-    throw InputError("option " + option + ": not a number: '" + text + "'");
+// A room side in metres: a number in (0, kMaxPosition].
+static double room_side(const std::string& text) {
+  double v = 0.0;
+  if (!parse_number(text, v) || !(v > 0.0 && v <= kMaxPosition))
+    throw InputError("option --room: expected each side in (0, " + number_text(kMaxPosition) +
+                     "] m, got '" + text + "'");
   return v;
 }
 
@@ -57,7 +59,7 @@ audio::BrirSynthConfig room_config(const RoomOptions& o, double sample_rate) {
     std::vector<double> dims;
     std::stringstream in(o.room);
     std::string part;
-    while (std::getline(in, part, 'x')) dims.push_back(parse_number(part, "--room"));
+    while (std::getline(in, part, 'x')) dims.push_back(room_side(part));
     if (dims.size() != 3)
       throw InputError("option --room: expected LxWxH (e.g. 5x4x3), got '" + o.room + "'");
     c.room.min_corner.setZero();
@@ -154,6 +156,10 @@ void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
 }
 
 void check_sweep_options(const SonifySetup& s) {
+  const audio::PitchMapping& pitch = s.sweep.pitch;
+  if (pitch.near_below_m > pitch.far_above_m)
+    throw InputError("options --near-below " + number_text(pitch.near_below_m) + " and --far-above " +
+                     number_text(pitch.far_above_m) + ": the near threshold must not exceed the far one");
   try {
     s.sweep.validate();
   } catch (const std::invalid_argument& e) {
