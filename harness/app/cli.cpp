@@ -16,6 +16,8 @@ int run_cli(int argc, char** argv) {
   CLI::App app{"sonomap: depth sensing -> online map -> 360-degree rasters -> binaural sound"};
   app.require_subcommand(1);
   app.fallthrough();  // --quiet and --threads work after the command name too
+  // Every command's --help shows every default (subcommands inherit this).
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", code_version());
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress bar and no summary screen");

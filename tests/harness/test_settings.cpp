@@ -19,34 +19,11 @@ namespace fs = std::filesystem;
 using sonomap::harness::load_scenario;
 using sonomap::test::input_error_of;
 using sonomap::test::run_sonomap;
+using sonomap::test::kBase;
 using sonomap::test::ScratchDir;
+using sonomap::test::with_line;
 
 namespace {
-
-// A valid scenario; the comments give the 1-based line numbers the tests refer to.
-const std::string kScene =
-    "name: probe\n"                                              // 1
-    "frames: 3\n"                                                // 2
-    "sensor:\n"                                                  // 3
-    "  intrinsics: {fx: 525, fy: 525, cx: 319.5, cy: 239.5}\n"   // 4
-    "  max_range: 5.0\n"                                         // 5
-    "  rate: 30\n"                                               // 6
-    "body:\n"                                                    // 7
-    "  interpolation: linear_slerp\n"                            // 8
-    "  keyframes:\n"                                             // 9
-    "    - {time: 0, position: [0, 0, 1.5], yaw: 0}\n"           // 10
-    "    - {time: 1, position: [1, 0, 1.5], yaw: 90}\n"          // 11
-    "static:\n"                                                  // 12
-    "  - name: room\n"                                           // 13
-    "    room: {size: [4, 4, 2.5]}\n";                           // 14
-
-// kScene with line `line` (1-based) replaced by `text`.
-std::string with_line(int line, const std::string& text) {
-  std::istringstream in(kScene);
-  std::string out, row;
-  for (int number = 1; std::getline(in, row); ++number) out += (number == line ? text : row) + "\n";
-  return out;
-}
 
 // The error of loading `text`: it names the file, the line and the key.
 void check_refused(const std::string& text, int line, const std::string& key) {
@@ -57,6 +34,14 @@ void check_refused(const std::string& text, int line, const std::string& key) {
   CHECK(message.find(file.string() + ":" + std::to_string(line) + ":") != std::string::npos);
   CHECK(message.find("'" + key + "'") != std::string::npos);
 }
+
+sonomap::sim::Scenario accepted(const std::string& text) {
+  ScratchDir dir("settings");
+  return load_scenario(dir.write("ok.yaml", text));
+}
+
+// kBase with `text` after its line 6 (the sensor's max_range): sensor keys at line 7.
+std::string with_sensor_line(const std::string& text) { return with_line(6, "  max_range: 5.0\n" + text); }
 
 // The names after "(settings: " in a message, up to the closing parenthesis.
 std::vector<std::string> listed_settings(const std::string& message) {
@@ -80,22 +65,21 @@ TEST_CASE("intrinsics: fx = 1e300 is refused naming sensor.intrinsics.fx and its
 
 TEST_CASE("ranges: a camera range of 1e300 m is refused (ranges reach at most 100 m)",
           "[settings][bounds]") {
-  check_refused(with_line(5, "  max_range: 1e300"), 5, "sensor.max_range");
-  check_refused(with_line(5, "  max_range: 100.5"), 5, "sensor.max_range");
-  ScratchDir dir("settings");
-  CHECK(load_scenario(dir.write("ok.yaml", with_line(5, "  max_range: 100"))).camera.max_range == 100.0);
+  check_refused(with_line(6, "  max_range: 1e300"), 6, "sensor.max_range");
+  check_refused(with_line(6, "  max_range: 100.5"), 6, "sensor.max_range");
+  CHECK(accepted(with_line(6, "  max_range: 100")).camera.max_range == 100.0);
 }
 
 TEST_CASE("rates: a frame rate above 1 kHz is refused", "[settings][bounds]") {
-  check_refused(with_line(6, "  rate: 1e300"), 6, "sensor.rate");
-  check_refused(with_line(6, "  rate: 1000.5"), 6, "sensor.rate");
+  check_refused(with_sensor_line("  rate: 1e300"), 7, "sensor.rate");
+  CHECK(accepted(with_sensor_line("  rate: 1000")).camera.rate_hz == 1000.0);
 }
 
 TEST_CASE("positions: keyframe and mounting positions beyond 10 km are refused",
           "[settings][bounds]") {
   check_refused(with_line(10, "    - {time: 0, position: [1e300, 0, 1.5], yaw: 0}"), 10,
                 "body.keyframes[0].position[0]");
-  check_refused(with_line(6, "  mounting: {position: [0, 0, 1e300]}"), 6,
+  check_refused(with_sensor_line("  mounting: {position: [0, 0, 1e300]}"), 7,
                 "sensor.mounting.position[2]");
   check_refused(with_line(14, "    room: {size: [4, 4, 2.5]}\n    pose: {position: [10001, 0, 0]}"),
                 15, "static[0].pose.position[0]");
@@ -104,16 +88,14 @@ TEST_CASE("positions: keyframe and mounting positions beyond 10 km are refused",
 TEST_CASE("seeds: -1 and 2^63 are refused, 2^63-1 is the largest seed", "[settings][bounds]") {
   check_refused(with_line(1, "seed: -1"), 1, "seed");
   check_refused(with_line(1, "seed: 9223372036854775808"), 1, "seed");
-  ScratchDir dir("settings");
-  CHECK(load_scenario(dir.write("ok.yaml", with_line(1, "seed: 9223372036854775807"))).seed ==
-        9223372036854775807ull);
+  CHECK(accepted(with_line(1, "seed: 9223372036854775807")).seed == 9223372036854775807ull);
 }
 
 TEST_CASE("mesh vertices: a vertex at 1e30 m is refused naming the mesh file key",
           "[settings][bounds]") {
   ScratchDir dir("settings");
   dir.write("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1e30 0\nf 1 2 3\n");
-  const fs::path file = dir.write("probe.yaml", kScene + "  - name: far\n    mesh: {file: far.obj}\n");
+  const fs::path file = dir.write("probe.yaml", kBase + "  - name: far\n    mesh: {file: far.obj}\n");
   const std::string message = input_error_of([&] { load_scenario(file); });
   INFO(message);
   CHECK(message.find("static[1].mesh.file") != std::string::npos);
@@ -123,23 +105,22 @@ TEST_CASE("mesh vertices: a vertex at 1e30 m is refused naming the mesh file key
 TEST_CASE("a scenario with three bad keys reports all three, each with its line",
           "[settings][scenario]") {
   std::string text = with_line(1, "seed: -1");
-  text = text.substr(0, text.find("  intrinsics")) + "  intrinsics: {fx: 1e300, fy: 525, cx: 319.5, cy: 239.5}\n" +
-         text.substr(text.find("  max_range"));
-  text.replace(text.find("  rate: 30"), 10, "  rat: 30");
+  text.replace(text.find("fx: 525"), 7, "fx: 1e300");
+  text.replace(text.find("  min_range: 0.3"), 16, "  rat: 30");
   ScratchDir dir("settings");
   const fs::path file = dir.write("probe.yaml", text);
   const std::string message = input_error_of([&] { load_scenario(file); });
   INFO(message);
   CHECK(message.find("3 problems") != std::string::npos);
   for (const auto& [line, key] : std::vector<std::pair<int, std::string>>{
-           {1, "seed"}, {4, "sensor.intrinsics.fx"}, {6, "sensor.rat"}})
+           {1, "seed"}, {4, "sensor.intrinsics.fx"}, {5, "sensor.rat"}})
     CHECK(message.find(file.string() + ":" + std::to_string(line) + ": key '" + key + "'") !=
           std::string::npos);
 }
 
 TEST_CASE("at most 20 errors of a scenario are listed, and the count of the rest",
           "[settings][scenario]") {
-  std::string text = kScene + "  - name: boxes\n    box: {size: [1, 1, 1]}\n";
+  std::string text = kBase + "  - name: boxes\n    box: {size: [1, 1, 1]}\n";
   for (int i = 0; i < 25; ++i) text += "    bad" + std::to_string(i) + ": 1\n";
   ScratchDir dir("settings");
   const std::string message = input_error_of([&] { load_scenario(dir.write("probe.yaml", text)); });
@@ -220,7 +201,7 @@ TEST_CASE("a voxel whose map would exceed --max-memory is refused before any wor
   CHECK(sonomap::test::nothing_written(out));
 }
 
-TEST_CASE("--set mapper.nope lists the mapper's fields, and summary.json records every one of them",
+TEST_CASE("set mapper.nope: the run lists the mapper's fields, and summary.json records every one of them",
           "[settings][summary]") {
   ScratchDir scratch("settings-summary");
   const std::string scenario = sonomap::test::shipped("scenes/smoke.yaml").string();
