@@ -103,8 +103,7 @@ double estimated_map_bytes(const Mapper& mapper, double surface_area) {
   if (voxel <= 0.0) return 0.0;
   const double leaf_side = 8.0 * voxel;
   const double leaves = 2.0 * surface_area / (leaf_side * leaf_side);
-  double leaf_bytes = 512.0 * 8.0 + 128.0;  // (distance, weight) floats and masks
-  if (dynamic_cast<const VdbGpdf*>(&mapper)) leaf_bytes += 64.0 * 64.0 * 8.0 + 64.0 * 24.0;
+  const double leaf_bytes = 512.0 * 8.0 + 128.0;  // (distance, weight) floats and masks
   return leaves * leaf_bytes;
 }
 

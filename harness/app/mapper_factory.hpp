@@ -36,8 +36,9 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
 // The mapper's (global) voxel size in metres; 0 for a mapper without a grid.
 double mapper_voxel(const Mapper& mapper);
 // Estimated bytes of the mapper's map over `surface_area` m^2 of surfaces: VDB leaves of 8^3
-// voxels along the surfaces (two deep for the truncation band), each with its grid values and,
-// for VDB-GPDF, its global GP (a dense matrix over up to 8 x 8 crossings).
+// (distance, weight) voxels along the surfaces, two deep for the truncation band. On the smoke
+// scene (84 m^2) at 0.05 m it says 4.4 MB; `bench map` measured a peak of 4.5 MB (VDB-GPDF)
+// and 4.3 MB (TSDF) after 60 frames.
 double estimated_map_bytes(const Mapper& mapper, double surface_area);
 
 // Every mapper's settings with default, bounds and meaning (docs/settings.md, `--help`).
