@@ -22,7 +22,7 @@ int run_cli(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress bar and no summary screen");
   app.add_option("--threads", global.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096));
   std::unique_ptr<tbb::global_control> thread_limit;
   app.parse_complete_callback([&] {
     if (global.threads > 0)
