@@ -16,11 +16,13 @@ int run_cli(int argc, char** argv) {
   CLI::App app{"sonomap: depth sensing -> online map -> 360-degree rasters -> binaural sound"};
   app.require_subcommand(1);
   app.fallthrough();  // --quiet and --threads work after the command name too
+  // Every command's --help shows every default (subcommands inherit this).
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", code_version());
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress bar and no summary screen");
   app.add_option("--threads", global.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096));
   std::unique_ptr<tbb::global_control> thread_limit;
   app.parse_complete_callback([&] {
     if (global.threads > 0)
@@ -38,6 +40,7 @@ int run_cli(int argc, char** argv) {
   add_bench_command(app, global);
   add_score_command(app, global);
   add_diff_command(app, global);
+  add_keys_command(app, global);
 
   try {
     app.parse(argc, argv);

@@ -25,6 +25,9 @@ void add_sonify_command(CLI::App& app, const GlobalOptions& global);
 void add_bench_command(CLI::App& app, const GlobalOptions& global);
 void add_score_command(CLI::App& app, const GlobalOptions& global);
 void add_diff_command(CLI::App& app, const GlobalOptions& global);
+void add_keys_command(CLI::App& app, const GlobalOptions& global);
+// The key reference `sonomap keys` prints (docs/settings.md holds it).
+std::string key_reference_markdown();
 
 // Parses argv and runs the chosen command. Returns the process exit status:
 // 0 success, 2 bad input (message names file, line and key), 1 other failure.

@@ -2,62 +2,23 @@
 #include "harness/app/mapper_factory.hpp"
 
 #include "core/depth_only.hpp"
-#include "core/tsdf.hpp"
-#include "core/vdb_gpdf.hpp"
+#include "harness/app/config_fields.hpp"
 #include "harness/support/errors.hpp"
 
 #include <cmath>
-#include <map>
 #include <stdexcept>
-#include <variant>
 
 namespace sonomap::harness {
 namespace {
 
-// The settable fields of one mapper's config, by the name users write after "mapper.".
-using FieldRef = std::variant<double*, int*, bool*>;
-using FieldTable = std::map<std::string, FieldRef>;
-
-std::string field_list(const FieldTable& table) {
-  std::string names;
-  for (const auto& entry : table) names += (names.empty() ? "" : ", ") + entry.first;
-  return names;
-}
-
-void apply(const FieldTable& table, const std::string& mapper, const Setting& s) {
-  const auto it = table.find(s.key);
-  if (it == table.end())
-    throw InputError(s.source + ": mapper '" + mapper + "' has no setting '" + s.key +
-                     "' (settings: " + field_list(table) + ")");
-  const auto bad = [&](const char* expected) {
-    return InputError(s.source + ": key 'mapper." + s.key + "': expected " + expected + ", got '" +
-                      s.value + "'");
-  };
-  std::visit(
-      [&](auto* field) {
-        using T = std::remove_pointer_t<decltype(field)>;
-        if constexpr (std::is_same_v<T, bool>) {
-          if (s.value == "true" || s.value == "on" || s.value == "1") *field = true;
-          else if (s.value == "false" || s.value == "off" || s.value == "0") *field = false;
-          else throw bad("true or false");
-        } else {
-          size_t used = 0;
-          double v = 0;
-          try {
-            v = std::stod(s.value, &used);
-          } catch (const std::exception&) {
-            throw bad("a number");
-          }
-          if (used != s.value.size() || !std::isfinite(v)) throw bad("a number");
-          if constexpr (std::is_same_v<T, int>) {
-            if (v != std::floor(v) || std::abs(v) > 1e9) throw bad("a whole number");
-            *field = static_cast<int>(v);
-          } else {
-            *field = v;
-          }
-        }
-      },
-      it->second);
+void apply(const FieldTable& table, const std::string& mapper, const std::vector<Setting>& settings) {
+  for (const Setting& s : settings) {
+    const Field* field = find_field(table, s.key);
+    if (!field)
+      throw InputError(s.source + ": mapper '" + mapper + "' has no setting '" + s.key +
+                       "' (settings: " + (table.empty() ? "none" : field_names(table)) + ")");
+    set_field(*field, "mapper." + s.key, s.value, s.source);
+  }
 }
 
 // Runs the mapper's own validation and reports its message as bad input.
@@ -73,30 +34,7 @@ std::unique_ptr<Mapper> checked(const std::string& mapper, Make make) {
 std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& settings) {
   VdbGpdfConfig c;
   if (voxel > 0) c.global_voxel = voxel;
-  FieldTable table{{"local_voxel", &c.local_voxel},
-                   {"voxel_downsample", &c.voxel_downsample},
-                   {"voxel", &c.global_voxel},
-                   {"global_voxel", &c.global_voxel},
-                   {"lambda", &c.lambda},
-                   {"map_noise", &c.map_noise},
-                   {"query_step", &c.query_step},
-                   {"trunc_behind", &c.trunc_behind},
-                   {"trunc_front", &c.trunc_front},
-                   {"carving", &c.free_space_carving},
-                   {"carving_step", &c.carving_step},
-                   {"variance_cap", &c.variance_cap},
-                   {"inverse_variance_fusion", &c.inverse_variance_fusion},
-                   {"weight_cap", &c.weight_cap},
-                   {"g_gpdf_min_touched", &c.g_gpdf_min_touched},
-                   {"smooth_min", &c.smooth_min},
-                   {"global_neighbours", &c.global_neighbours},
-                   {"recon_min_weight", &c.recon_min_weight},
-                   {"min_range", &c.min_range},
-                   {"max_range", &c.max_range}};
-  bool log_gpis = c.kernel == GpKernel::LogGpisMatern32;
-  table["log_gpis"] = &log_gpis;
-  for (const Setting& s : settings) apply(table, "vdb_gpdf", s);
-  c.kernel = log_gpis ? GpKernel::LogGpisMatern32 : GpKernel::RevertingSE;
+  apply(vdb_gpdf_fields(c), "vdb_gpdf", settings);
   return checked("vdb_gpdf", [&] { return std::make_unique<VdbGpdf>(c); });
 }
 
@@ -106,17 +44,17 @@ std::unique_ptr<Mapper> make_tsdf(double voxel, const std::vector<Setting>& sett
     c.truncation *= voxel / c.voxel;  // keep the truncation at the same number of voxels
     c.voxel = voxel;
   }
-  FieldTable table{{"voxel", &c.voxel},           {"truncation", &c.truncation},
-                   {"carving", &c.space_carving}, {"weight_cap", &c.weight_cap},
-                   {"min_weight", &c.min_weight}, {"min_range", &c.min_range},
-                   {"max_range", &c.max_range}};
-  for (const Setting& s : settings) apply(table, "tsdf", s);
+  apply(tsdf_fields(c), "tsdf", settings);
   return checked("tsdf", [&] { return std::make_unique<Tsdf>(c); });
 }
 
-std::unique_ptr<Mapper> make_depth_only(const std::vector<Setting>& settings) {
-  for (const Setting& s : settings) apply({}, "depth_only", s);
-  return std::make_unique<DepthOnlyMapper>();
+// Calls `use(name, table)` with each mapper's table over a config of its defaults.
+template <typename Use>
+void for_each_default_table(Use use) {
+  VdbGpdfConfig vdb;
+  use("vdb_gpdf", vdb_gpdf_fields(vdb));
+  TsdfConfig tsdf;
+  use("tsdf", tsdf_fields(tsdf));
 }
 
 }  // namespace
@@ -125,14 +63,64 @@ std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "depth_onl
 
 std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
                                     const std::vector<Setting>& settings) {
-  if (voxel < 0 || !std::isfinite(voxel))
-    throw InputError("--voxel must be a positive size in metres, got " + std::to_string(voxel));
+  if (voxel != 0.0 && !(voxel >= kMinVoxel && voxel <= kMaxVoxel))
+    throw InputError("--voxel " + number_text(voxel) + ": expected a voxel size in [" +
+                     number_text(kMinVoxel) + ", " + number_text(kMaxVoxel) + "] m");
   if (name == "vdb_gpdf") return make_vdb_gpdf(voxel, settings);
   if (name == "tsdf") return make_tsdf(voxel, settings);
-  if (name == "depth_only") return make_depth_only(settings);
+  if (name == "depth_only") {
+    apply({}, name, settings);
+    return std::make_unique<DepthOnlyMapper>();
+  }
   std::string names;
   for (const auto& n : mapper_names()) names += (names.empty() ? "" : ", ") + n;
   throw InputError("--mapper " + name + ": unknown mapper (known: " + names + ")");
+}
+
+std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Mapper& mapper) {
+  std::vector<std::pair<std::string, std::string>> entries{{"mapper", mapper.name()}};
+  const auto add = [&](const FieldTable& table) {
+    for (const Field& f : table) entries.emplace_back(f.name, field_value(f));
+  };
+  if (const auto* v = dynamic_cast<const VdbGpdf*>(&mapper)) {
+    VdbGpdfConfig c = v->config();
+    add(vdb_gpdf_fields(c));
+  } else if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) {
+    TsdfConfig c = t->config();
+    add(tsdf_fields(c));
+  }
+  return entries;
+}
+
+double mapper_voxel(const Mapper& mapper) {
+  if (const auto* v = dynamic_cast<const VdbGpdf*>(&mapper)) return v->config().global_voxel;
+  if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) return t->config().voxel;
+  return 0.0;
+}
+
+double estimated_map_bytes(const Mapper& mapper, double surface_area) {
+  const double voxel = mapper_voxel(mapper);
+  if (voxel <= 0.0) return 0.0;
+  const double leaf_side = 8.0 * voxel;
+  const double leaves = 2.0 * surface_area / (leaf_side * leaf_side);
+  const double leaf_bytes = 512.0 * 8.0 + 128.0;  // (distance, weight) floats and masks
+  return leaves * leaf_bytes;
+}
+
+std::string mapper_settings_markdown() {
+  std::string text;
+  for_each_default_table([&](const std::string& name, const FieldTable& table) {
+    text += "\n### Mapper `" + name + "`\n\n" + markdown_table(table, "mapper.");
+  });
+  return text;
+}
+
+std::string mapper_settings_help() {
+  std::string text;
+  for_each_default_table([&](const std::string& name, const FieldTable& table) {
+    text += "Mapper settings of " + name + " (--set mapper.FIELD=VALUE):\n" + help_lines(table, "mapper.");
+  });
+  return text;
 }
 
 }  // namespace sonomap::harness

@@ -6,6 +6,7 @@
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/formats/tum_io.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/fields.hpp"
 #include "harness/support/interrupt.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
@@ -92,7 +93,7 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
                       "is replaced")
       ->required();
   command->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, kMaxFrames));
   command->add_option("--set", options->overrides,
                       "Override a scenario key, e.g. --set sensor.noise.model=none (repeatable)")
       ->allow_extra_args(false);  // one key=value per --set, so a scenario after it stays positional

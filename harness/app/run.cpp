@@ -11,6 +11,7 @@
 #include "eval/ground_truth.hpp"
 #include "eval/metrics.hpp"
 #include "harness/app/mapper_factory.hpp"
+#include "harness/support/fields.hpp"
 #include "harness/app/sonify.hpp"
 #include "harness/formats/mesh_io.hpp"
 #include "harness/formats/scenario_yaml.hpp"
@@ -158,11 +159,10 @@ RunOutcome run_scenario(const RunOptions& options) {
   const bool has_truth = source->truth(0.0).has_value();
 
   auto mapper = make_mapper(options.mapper, options.voxel, settings.mapper);
-  if (!settings.ghost_tolerance_set) {
-    // docs/conventions.md: a ghost is more than 2 voxels closer than the truth.
-    for (const auto& [key, value] : mapper->config_entries())
-      if (key == "global_voxel" || key == "voxel") settings.metrics.ghost_tolerance = 2.0 * std::stod(value);
-  }
+  // docs/conventions.md: a ghost is more than 2 voxels closer than the truth.
+  if (!settings.ghost_tolerance_set && mapper_voxel(*mapper) > 0.0)
+    settings.metrics.ghost_tolerance = 2.0 * mapper_voxel(*mapper);
+  check_memory_budget(*mapper, *source, options.max_memory_gib);
 
   StagedDirectory staged(options.out);
   const fs::path dir = staged.path();
@@ -320,24 +320,11 @@ RunOutcome run_scenario(const RunOptions& options) {
   }
   progress.finish();
 
-  json config{{"mapper", mapper->name()}, {"mapper_config", json::object()},
-              {"raster", {{"azimuth_bins", settings.raster.azimuth_bins},
-                          {"band_min", settings.raster.band_min},
-                          {"band_max", settings.raster.band_max},
-                          {"row_height", settings.raster.row_height},
-                          {"max_range", settings.raster.max_range}}},
-              {"metrics", {{"ghost_tolerance", settings.metrics.ghost_tolerance},
-                           {"edge_jump", settings.metrics.edge_jump}}},
-              {"edf", {{"enabled", settings.edf_enabled}, {"every", settings.edf_every},
-                       {"sample_radius", settings.edf.sample_radius},
-                       {"hit_tolerance", settings.edf.hit_tolerance},
-                       {"max_steps", settings.edf.max_steps},
-                       {"max_range", settings.edf.max_range},
-                       {"trace_rows", settings.edf_trace_rows},
-                       {"trace_heights", settings.edf.trace_heights}}},
-              {"frames", frame_count}, {"every", options.every}, {"seed", source->seed()},
-              {"overrides", options.overrides}};
-  for (const auto& [key, value] : mapper->config_entries()) config["mapper_config"][key] = value;
+  json config = run_settings_json(settings);
+  config.update({{"mapper", mapper->name()}, {"mapper_config", json::object()},
+                 {"frames", frame_count}, {"every", options.every}, {"seed", source->seed()},
+                 {"overrides", options.overrides}});
+  for (const auto& [key, value] : mapper_config_entries(*mapper)) config["mapper_config"][key] = value;
 
   json summary{{"scenario", {{"name", source->name()}, {"file", options.scenario.string()}}},
                {"sweeps", sweeps.levels()},
@@ -437,14 +424,20 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "PNGs or a ROS1 bag; docs/real-data.md). Recordings: no ground truth, no metrics")->required();
   cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
   cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, kMaxFrames));
   cmd->add_option("--every", options->every,
                   "Evaluate rasters, truth and metrics every K-th frame (and the last)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, kMaxFrames))->capture_default_str();
   cmd->add_option("--mapper", options->mapper, "Mapper: vdb_gpdf, tsdf or depth_only")
       ->capture_default_str();
-  cmd->add_option("--voxel", options->voxel, "Global voxel size in metres (default: the mapper's)");
-  cmd->add_option("--seed", options->seed, "Run seed (overrides the scenario's)");
+  cmd->add_option("--voxel", options->voxel, "Global voxel size in metres (default: the mapper's)")
+      ->check(CLI::Range(kMinVoxel, kMaxVoxel));
+  cmd->add_option("--seed", options->seed, "Run seed (overrides the scenario's)")
+      ->check(CLI::Range(std::uint64_t{0}, kMaxSeed));
+  cmd->add_option("--max-memory", options->max_memory_gib,
+                  "Map memory budget in GiB; a voxel size whose estimated map needs more is "
+                  "refused (0: half the RAM)")
+      ->check(CLI::Range(0.0, 1e6))->capture_default_str();
   cmd->add_option("--set", options->overrides,
                   "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*, edf.*)");
   cmd->add_option("--pictures", options->picture_frames,
@@ -455,6 +448,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "BRIR directory for the sweeps (default: synthesise the room from the map)");
   cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
+  cmd->footer(run_keys_help());
   cmd->callback([options, &global] {
     options->quiet = global.quiet;
     install_interrupt_handler();

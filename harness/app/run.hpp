@@ -41,6 +41,7 @@ struct RunOptions {
   std::string mapper = "vdb_gpdf";
   double voxel = 0.0;  // global voxel size in metres; 0: the mapper's default
   std::optional<std::uint64_t> seed;
+  double max_memory_gib = 0.0;  // map memory budget; 0: half the machine's RAM
   std::vector<int> picture_frames;  // empty: the last evaluated frame; -1: none
   std::vector<int> sweep_frames;    // empty: the last evaluated frame; -1: none
   // BRIR directory (one SOFA per distance) for the sweeps; empty: synthesise a shoebox room

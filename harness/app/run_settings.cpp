@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/app/run_settings.hpp"
 
+#include "core/tsdf.hpp"
+#include "core/vdb_gpdf.hpp"
+#include "harness/app/config_fields.hpp"
 #include "harness/support/errors.hpp"
 
-#include <cmath>
-#include <map>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <stdexcept>
 
 namespace sonomap::harness {
@@ -16,78 +21,64 @@ bool is_run_key(const std::string& key) {
   return false;
 }
 
-double parse_number(const Setting& s) {
-  try {
-    size_t used = 0;
-    const double v = std::stod(s.value, &used);
-    if (used == s.value.size() && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError(s.source + ": key '" + s.key + "': expected a number, got '" + s.value + "'");
+std::string run_key_list(std::vector<FieldGroup>& groups) {
+  std::string list = "mapper.*";
+  for (const FieldGroup& g : groups)
+    for (const Field& f : g.fields) list += ", " + g.prefix + f.name;
+  return list;
 }
 
 void apply_run_setting(RunSettings& settings, const Setting& s) {
-  const std::string& k = s.key;
-  if (k.rfind("mapper.", 0) == 0) {
-    settings.mapper.push_back({k.substr(7), s.value, s.source});
+  if (s.key.rfind("mapper.", 0) == 0) {
+    settings.mapper.push_back({s.key.substr(7), s.value, s.source});
     return;
   }
-  std::map<std::string, double*> numbers = {
-      {"raster.band_min", &settings.raster.band_min},
-      {"raster.band_max", &settings.raster.band_max},
-      {"raster.row_height", &settings.raster.row_height},
-      {"raster.max_range", &settings.raster.max_range},
-      {"metrics.ghost_tolerance", &settings.metrics.ghost_tolerance},
-      {"metrics.edge_jump", &settings.metrics.edge_jump},
-      {"edf.sample_radius", &settings.edf.sample_radius},
-      {"edf.hit_tolerance", &settings.edf.hit_tolerance},
-      {"edf.max_range", &settings.edf.max_range},
-  };
-  if (auto it = numbers.find(k); it != numbers.end()) {
-    *it->second = parse_number(s);
-    if (k == "metrics.ghost_tolerance") settings.ghost_tolerance_set = true;
-    if (k == "edf.max_range") settings.edf_max_range_set = true;
-    if (k.rfind("edf.", 0) == 0 && !(*it->second > 0.0))
-      throw InputError(s.source + ": key '" + k + "': expected a number > 0, got '" + s.value + "'");
-    return;
+  std::vector<FieldGroup> groups = run_key_fields(settings);
+  for (const FieldGroup& g : groups) {
+    if (s.key.rfind(g.prefix, 0) != 0) continue;
+    if (const Field* f = find_field(g.fields, s.key.substr(g.prefix.size()))) {
+      set_field(*f, s.key, s.value, s.source);
+      settings.ghost_tolerance_set |= s.key == "metrics.ghost_tolerance";
+      settings.edf_max_range_set |= s.key == "edf.max_range";
+      return;
+    }
   }
-  if (k == "edf.max_steps" || k == "edf.every") {
-    const double v = parse_number(s);
-    if (v != std::floor(v) || v < 1 || v > 1e6)
-      throw InputError(s.source + ": key '" + k + "': expected a whole number in [1, 1000000]");
-    (k == "edf.every" ? settings.edf_every : settings.edf.max_steps) = static_cast<int>(v);
-    return;
-  }
-  if (k == "edf.trace_rows") {
-    const double v = parse_number(s);
-    if (v != std::floor(v) || v < 0 || v > 100)
-      throw InputError(s.source + ": key '" + k + "': expected a whole number in [0, 100]");
-    settings.edf_trace_rows = static_cast<int>(v);
-    return;
-  }
-  if (k == "edf.enabled") {
-    if (s.value != "true" && s.value != "false")
-      throw InputError(s.source + ": key '" + k + "': expected true or false, got '" + s.value + "'");
-    settings.edf_enabled = s.value == "true";
-    return;
-  }
-  if (k == "raster.azimuth_bins") {
-    const double v = parse_number(s);
-    if (v != std::floor(v) || v < 1 || v > 36000)
-      throw InputError(s.source + ": key '" + k + "': expected a whole number in [1, 36000]");
-    settings.raster.azimuth_bins = static_cast<int>(v);
-    return;
-  }
-  throw InputError(s.source + ": unknown key '" + k +
-                   "' (run keys: mapper.*, raster.band_min, raster.band_max, raster.row_height, "
-                   "raster.max_range, raster.azimuth_bins, metrics.ghost_tolerance, "
-                   "metrics.edge_jump, edf.enabled, edf.every, edf.sample_radius, "
-                   "edf.hit_tolerance, edf.max_steps, edf.max_range, edf.trace_rows)");
+  throw InputError(s.source + ": unknown key '" + s.key + "' (run keys: " + run_key_list(groups) + ")");
+}
+
+// The EDF circle's rays at the centres of equal slices of the band the circle covers.
+void derive_edf_settings(RunSettings& settings) {
+  if (!settings.edf_max_range_set) settings.edf.max_range = settings.raster.max_range;
+  const double slice =
+      (settings.raster.band_max - settings.raster.band_min) / std::max(1, settings.edf_trace_rows);
+  settings.edf.trace_heights.clear();
+  for (int j = 0; j < settings.edf_trace_rows; ++j)
+    settings.edf.trace_heights.push_back(settings.raster.band_min + (j + 0.5) * slice);
+}
+
+// The area of the scene's surfaces at the start, from the exact world triangles; recorded data
+// has none, so a sphere of 5 m radius (a room around one place) stands in for it.
+double surface_area(const FrameSource& source) {
+  const auto truth = source.truth(0.0);
+  if (!truth) return 4.0 * 3.14159265358979 * 25.0;
+  double area = 0.0;
+  for (const sim::WorldTriangle& t : *truth)
+    area += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm();
+  return area;
 }
 
 }  // namespace
 
-// Splits "key=value" overrides into scenario overrides and run settings.
+std::vector<FieldGroup> run_key_fields(RunSettings& s) {
+  FieldTable edf = {
+      flag("enabled", &s.edf_enabled, "compare the map's distance field along rays (edf.csv)"),
+      whole("every", &s.edf_every, 1, 1000000, "EDF comparison every n-th evaluated frame"),
+      whole("trace_rows", &s.edf_trace_rows, 0, 100,
+            "rays per bin across the obstacle band (0: one at the sensor's height)")};
+  for (Field& f : edf_raster_fields(s.edf)) edf.push_back(std::move(f));
+  return {{"raster.", raster_fields(s.raster)}, {"metrics.", metrics_fields(s.metrics)}, {"edf.", edf}};
+}
+
 void split_overrides(const std::vector<std::string>& overrides, std::vector<std::string>& scenario,
                      RunSettings& settings) {
   for (const std::string& o : overrides) {
@@ -105,12 +96,7 @@ void split_overrides(const std::vector<std::string>& overrides, std::vector<std:
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--set raster.*: ") + e.what());
   }
-  if (!settings.edf_max_range_set) settings.edf.max_range = settings.raster.max_range;
-  // The EDF circle's rays at the centres of equal slices of the band the circle covers.
-  const double slice = (settings.raster.band_max - settings.raster.band_min) / std::max(1, settings.edf_trace_rows);
-  settings.edf.trace_heights.clear();
-  for (int j = 0; j < settings.edf_trace_rows; ++j)
-    settings.edf.trace_heights.push_back(settings.raster.band_min + (j + 0.5) * slice);
+  derive_edf_settings(settings);
   try {
     settings.edf.validate();
   } catch (const std::invalid_argument& e) {
@@ -118,5 +104,50 @@ void split_overrides(const std::vector<std::string>& overrides, std::vector<std:
   }
 }
 
+nlohmann::json run_settings_json(const RunSettings& settings) {
+  RunSettings copy = settings;
+  nlohmann::json out = nlohmann::json::object();
+  for (const FieldGroup& g : run_key_fields(copy)) {
+    nlohmann::json& group = out[g.prefix.substr(0, g.prefix.size() - 1)];
+    for (const Field& f : g.fields) {
+      if (const double* const* d = std::get_if<double*>(&f.target)) group[f.name] = **d;
+      else if (const int* const* i = std::get_if<int*>(&f.target)) group[f.name] = **i;
+      else if (const bool* const* b = std::get_if<bool*>(&f.target)) group[f.name] = **b;
+      else group[f.name] = field_value(f);
+    }
+  }
+  out["edf"]["trace_heights"] = settings.edf.trace_heights;
+  return out;
+}
+
+void check_memory_budget(const Mapper& mapper, const FrameSource& source, double max_memory_gib) {
+  if (!(max_memory_gib >= 0.0) || max_memory_gib > 1e6)
+    throw InputError("--max-memory must be a size in GiB in [0, 1000000] (0: half the RAM)");
+  double budget = max_memory_gib * 1073741824.0;
+  if (budget == 0.0)
+    budget = 0.5 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  const double area = surface_area(source);
+  const double estimate = estimated_map_bytes(mapper, area);
+  if (estimate > budget)
+    throw InputError(fmt::format(
+        "the map would need about {:.3g} GiB (voxel {} m over {:.4g} m^2 of surface), more than "
+        "the --max-memory budget of {:.3g} GiB; use a larger voxel or raise --max-memory",
+        estimate / 1073741824.0, mapper_voxel(mapper), area, budget / 1073741824.0));
+}
+
+std::string run_keys_markdown() {
+  RunSettings defaults;
+  std::string text;
+  for (const FieldGroup& g : run_key_fields(defaults))
+    text += "\n### `" + g.prefix + "*`\n\n" + markdown_table(g.fields, g.prefix);
+  return text + mapper_settings_markdown();
+}
+
+std::string run_keys_help() {
+  RunSettings defaults;
+  std::string text = "Run keys (--set KEY=VALUE; key = default  range  meaning):\n";
+  for (const FieldGroup& g : run_key_fields(defaults)) text += help_lines(g.fields, g.prefix);
+  return text + mapper_settings_help();
+}
 
 }  // namespace sonomap::harness

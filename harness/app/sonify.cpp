@@ -4,6 +4,7 @@
 #include "harness/formats/sofa_io.hpp"
 #include "harness/formats/wav_io.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/fields.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
 
@@ -19,30 +20,36 @@ namespace sonomap::harness {
 
 fs::path default_hrir_file() { return "/usr/share/libmysofa/default.sofa"; }
 
+// Positions within 10 km of the origin (docs/settings.md, "Bounds").
+static const CLI::Range kPositionRange(-kMaxPosition, kMaxPosition);
+
 void add_room_options(CLI::App& cmd, RoomOptions& o) {
   cmd.add_option("--room", o.room, "Shoebox room LxWxH in metres (corner at the origin)")
       ->capture_default_str();
   cmd.add_option("--room-min", o.room_min, "Room corner x,y,z (with --room-max; e.g. a map's box)")
-      ->delimiter(',')->expected(3);
-  cmd.add_option("--room-max", o.room_max, "Opposite room corner x,y,z")->delimiter(',')->expected(3);
+      ->delimiter(',')->expected(3)->check(kPositionRange);
+  cmd.add_option("--room-max", o.room_max, "Opposite room corner x,y,z")
+      ->delimiter(',')->expected(3)->check(kPositionRange);
   cmd.add_option("--listener", o.listener, "Head position x,y,z (default: room centre, 1.5 m high)")
-      ->delimiter(',')->expected(3);
+      ->delimiter(',')->expected(3)->check(kPositionRange);
   cmd.add_option("--heading", o.heading_deg, "Direction the listener faces, degrees from +x")
-      ->capture_default_str();
+      ->check(CLI::Range(-3600.0, 3600.0))->capture_default_str();
   cmd.add_option("--rt60", o.rt60, "Reverberation time, seconds")->capture_default_str();
   cmd.add_option("--order", o.order, "Image-source reflection order")->capture_default_str();
   cmd.add_option("--ir-length", o.length_s, "BRIR length, seconds (0: the RT60)")
       ->capture_default_str();
-  cmd.add_option("--seed", o.seed, "Seed of the late-tail noise")->capture_default_str();
+  cmd.add_option("--seed", o.seed, "Seed of the late-tail noise")
+      ->check(CLI::Range(0ull, static_cast<unsigned long long>(kMaxSeed)))->capture_default_str();
   cmd.add_option("--hrir", o.hrir_file, "HRIR set (SOFA) the BRIRs are built from")
       ->capture_default_str();
 }
 
-static double parse_number(const std::string& text, const std::string& option) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v))
-    throw InputError("option " + option + ": not a number: '" + text + "'");
+// A room side in metres: a number in (0, kMaxPosition].
+static double room_side(const std::string& text) {
+  double v = 0.0;
+  if (!parse_number(text, v) || !(v > 0.0 && v <= kMaxPosition))
+    throw InputError("option --room: expected each side in (0, " + number_text(kMaxPosition) +
+                     "] m, got '" + text + "'");
   return v;
 }
 
@@ -57,7 +64,7 @@ audio::BrirSynthConfig room_config(const RoomOptions& o, double sample_rate) {
     std::vector<double> dims;
     std::stringstream in(o.room);
     std::string part;
-    while (std::getline(in, part, 'x')) dims.push_back(parse_number(part, "--room"));
+    while (std::getline(in, part, 'x')) dims.push_back(room_side(part));
     if (dims.size() != 3)
       throw InputError("option --room: expected LxWxH (e.g. 5x4x3), got '" + o.room + "'");
     c.room.min_corner.setZero();
@@ -139,8 +146,10 @@ void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
       ->capture_default_str();
   cmd.add_option("--fov-width", w.filter.fov_width_deg, "Field of view width, degrees")
       ->capture_default_str();
-  cmd.add_option("--min-range", w.filter.min_range_m, "Play only ranges >= this, metres");
-  cmd.add_option("--max-range", w.filter.max_range_m, "Play only ranges <= this, metres");
+  cmd.add_option("--min-range", w.filter.min_range_m, "Play only ranges >= this, metres")
+      ->check(CLI::Range(0.0, kMaxRange));
+  cmd.add_option("--max-range", w.filter.max_range_m, "Play only ranges <= this, metres")
+      ->check(CLI::Range(0.0, kMaxRange));
   cmd.add_option("--max-taps", w.filter.max_taps, "Ranging: only the N nearest taps (0: all)")
       ->capture_default_str();
   cmd.add_option("--max-objects", w.max_objects, "Objects: the N nearest pseudo-objects")
@@ -171,6 +180,10 @@ void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
 }
 
 void check_sweep_options(const SonifySetup& s) {
+  const audio::PitchMapping& pitch = s.sweep.pitch;
+  if (pitch.near_below_m > pitch.far_above_m)
+    throw InputError("options --near-below " + number_text(pitch.near_below_m) + " and --far-above " +
+                     number_text(pitch.far_above_m) + ": the near threshold must not exceed the far one");
   try {
     s.sweep.validate();
   } catch (const std::invalid_argument& e) {

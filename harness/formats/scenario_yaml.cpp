@@ -2,6 +2,7 @@
 #include "harness/formats/scenario_yaml.hpp"
 
 #include "harness/formats/mesh_io.hpp"
+#include "harness/formats/scenario_keys.hpp"
 #include "harness/support/errors.hpp"
 #include "sim/primitives.hpp"
 #include "sim/trajectory.hpp"
@@ -71,10 +72,36 @@ class Context {
   const fs::path& dir() const { return dir_; }
   void add_override(Override o) { overrides_.push_back(std::move(o)); }
 
+  // Runs `read`; the InputError it throws is kept (the first kMaxErrors of them) and reading
+  // goes on, so that one run reports every problem of the file. False if `read` failed.
+  template <typename Read>
+  bool attempt(Read read) const {
+    try {
+      read();
+      return true;
+    } catch (const InputError& e) {
+      if (errors_.size() < kMaxErrors) errors_.emplace_back(e.what());
+      else ++errors_left_off_;
+      return false;
+    }
+  }
+  // Throws all kept errors as one InputError (one line each), if there are any.
+  void throw_errors() const {
+    if (errors_.empty()) return;
+    if (errors_.size() == 1) throw InputError(errors_[0]);
+    std::string text = std::to_string(errors_.size() + errors_left_off_) + " problems in " + file_ + ":";
+    for (const std::string& e : errors_) text += "\n  " + e;
+    if (errors_left_off_ > 0) text += "\n  (" + std::to_string(errors_left_off_) + " more not shown)";
+    throw InputError(text);
+  }
+
  private:
+  static constexpr std::size_t kMaxErrors = 20;
   std::string file_;
   fs::path dir_;
   std::vector<Override> overrides_;
+  mutable std::vector<std::string> errors_;
+  mutable std::size_t errors_left_off_ = 0;
 };
 
 // --- scalars and vectors -------------------------------------------------------------------
@@ -84,6 +111,10 @@ double to_number(const Context& ctx, const YAML::Node& node, const std::string& 
   if (!node.IsScalar() || !YAML::convert<double>::decode(node, value))
     ctx.fail(node, key, "expected a number, got " + describe(node));
   if (!std::isfinite(value)) ctx.fail(node, key, "expected a finite number, got " + describe(node));
+  const ScenarioKey& declared = scenario_key(key);
+  if (!declared.range.contains(value))
+    ctx.fail(node, key, describe(node) + " is out of range: expected " + declared.range.text() +
+                            (declared.unit.empty() ? "" : " " + declared.unit));
   return value;
 }
 
@@ -91,6 +122,9 @@ long long to_integer(const Context& ctx, const YAML::Node& node, const std::stri
   long long value = 0;
   if (!node.IsScalar() || !YAML::convert<long long>::decode(node, value))
     ctx.fail(node, key, "expected a whole number, got " + describe(node));
+  const Range& range = scenario_key(key).range;
+  if (!range.contains(static_cast<double>(value)))
+    ctx.fail(node, key, describe(node) + " is out of range: expected a whole number in " + range.text());
   return value;
 }
 
@@ -140,8 +174,10 @@ class MapReader {
         known = known || name == a;
         list += (list.empty() ? "" : ", ") + a;
       }
-      if (!known) ctx_.fail(entry.first, sub(name), "unknown key (allowed here: " + list + ")");
-      if (!seen.insert(name).second) ctx_.fail(entry.first, sub(name), "key given twice");
+      ctx_.attempt([&] {
+        if (!known) ctx_.fail(entry.first, sub(name), "unknown key (allowed here: " + list + ")");
+        if (!seen.insert(name).second) ctx_.fail(entry.first, sub(name), "key given twice");
+      });
     }
   }
 
@@ -158,47 +194,47 @@ class MapReader {
     return n;
   }
 
+  // Optional values: a bad one is kept as an error (Context::attempt) and the fallback used,
+  // so the reader goes on and finds the file's other problems.
   double number(const std::string& name, double fallback) const {
-    return has(name) ? to_number(ctx_, node_[name], sub(name)) : fallback;
+    return value(name, fallback, [&] { return to_number(ctx_, node_[name], sub(name)); });
   }
   double number(const std::string& name) const {
     return to_number(ctx_, required(name), sub(name));
   }
-  // A number that must satisfy `ok`; `rule` says what is expected ("must be > 0").
+  // A number that must also satisfy `ok`; `rule` says what is expected.
   template <typename Ok>
   double checked(const std::string& name, double fallback, Ok ok, const char* rule) const {
     const double v = number(name, fallback);
-    if (has(name) && !ok(v)) ctx_.fail(node_[name], sub(name), std::string(rule));
-    return v;
+    if (has(name) && !ok(v)) ctx_.attempt([&] { ctx_.fail(node_[name], sub(name), std::string(rule)); });
+    return ok(v) ? v : fallback;
   }
-  double positive(const std::string& name, double fallback) const {
-    return checked(name, fallback, [](double v) { return v > 0.0; }, "must be > 0");
-  }
-  double non_negative(const std::string& name, double fallback) const {
-    return checked(name, fallback, [](double v) { return v >= 0.0; }, "must be >= 0");
-  }
-  int integer(const std::string& name, int fallback, int min_value, int max_value = INT_MAX) const {
-    if (!has(name)) return fallback;
-    const long long v = to_integer(ctx_, node_[name], sub(name));
-    if (v < min_value || v > max_value)
-      ctx_.fail(node_[name], sub(name),
-                "must be between " + std::to_string(min_value) + " and " + std::to_string(max_value));
-    return static_cast<int>(v);
+  int integer(const std::string& name, int fallback) const {
+    return static_cast<int>(value(name, static_cast<long long>(fallback),
+                                  [&] { return to_integer(ctx_, node_[name], sub(name)); }));
   }
   bool flag(const std::string& name, bool fallback) const {
-    return has(name) ? to_flag(ctx_, node_[name], sub(name)) : fallback;
+    return value(name, fallback, [&] { return to_flag(ctx_, node_[name], sub(name)); });
   }
   std::string text(const std::string& name, const std::string& fallback) const {
-    return has(name) ? to_text(ctx_, node_[name], sub(name)) : fallback;
+    return value(name, fallback, [&] { return to_text(ctx_, node_[name], sub(name)); });
   }
   Eigen::Vector3d vector3(const std::string& name, const Eigen::Vector3d& fallback) const {
-    return has(name) ? Eigen::Vector3d(to_vector(ctx_, node_[name], sub(name), 3)) : fallback;
+    return value(name, fallback,
+                 [&] { return Eigen::Vector3d(to_vector(ctx_, node_[name], sub(name), 3)); });
   }
   [[noreturn]] void fail(const std::string& name, const std::string& what) const {
     ctx_.fail(has(name) ? node_[name] : node_, sub(name), what);
   }
 
  private:
+  template <typename T, typename Read>
+  T value(const std::string& name, T fallback, Read read) const {
+    T v = fallback;
+    if (has(name)) ctx_.attempt([&] { v = read(); });
+    return v;
+  }
+
   const Context& ctx_;
   YAML::Node node_;
   std::string key_;
@@ -248,31 +284,34 @@ sim::TrajectorySpec read_trajectory(const Context& ctx, const YAML::Node& node,
   const std::string frames_key = map.sub("keyframes");
   const YAML::Node frames = require_sequence(ctx, map.required("keyframes"), frames_key);
   if (frames.size() == 0) ctx.fail(frames, frames_key, "the trajectory has no keyframes");
+  bool all_read = true;  // otherwise the keyframe's own error says it all
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::string k = item_key(frames_key, i);
-    const MapReader kf(ctx, frames[i], k, {"time", "position", "yaw", "pitch", "roll", "quaternion"});
-    sim::Keyframe keyframe;
-    keyframe.time = kf.number("time");
-    keyframe.position = to_vector(ctx, kf.required("position"), kf.sub("position"), 3);
-    keyframe.orientation = read_orientation(kf);
-    if (!trajectory.keyframes.empty()) {
-      const sim::Keyframe& previous = trajectory.keyframes.back();
-      if (!(keyframe.time > previous.time))
-        kf.fail("time", "keyframe times must increase: " + std::to_string(keyframe.time) +
-                            " s is not after " + std::to_string(previous.time) + " s");
-      // Slerp takes the shorter way round: a half turn or more between two keyframes would
-      // not turn the way the file seems to say.
-      const double turn = previous.orientation.angularDistance(keyframe.orientation);
-      if (turn >= radians(179.0))
-        kf.fail(kf.has("yaw") ? "yaw" : kf.has("quaternion") ? "quaternion" : "time",
-                "turns " + std::to_string(turn * 180.0 / kPi) +
-                    " degrees since the previous keyframe; interpolation takes the shorter way, "
-                    "so keep each turn under 179 degrees (add keyframes)");
-    }
-    trajectory.keyframes.push_back(keyframe);
+    all_read &= ctx.attempt([&] {
+      const MapReader kf(ctx, frames[i], k, {"time", "position", "yaw", "pitch", "roll", "quaternion"});
+      sim::Keyframe keyframe;
+      keyframe.time = kf.number("time");
+      keyframe.position = to_vector(ctx, kf.required("position"), kf.sub("position"), 3);
+      keyframe.orientation = read_orientation(kf);
+      if (!trajectory.keyframes.empty()) {
+        const sim::Keyframe& previous = trajectory.keyframes.back();
+        if (!(keyframe.time > previous.time))
+          kf.fail("time", "keyframe times must increase: " + std::to_string(keyframe.time) +
+                              " s is not after " + std::to_string(previous.time) + " s");
+        // Slerp takes the shorter way round: a half turn or more between two keyframes would
+        // not turn the way the file seems to say.
+        const double turn = previous.orientation.angularDistance(keyframe.orientation);
+        if (turn >= radians(179.0))
+          kf.fail(kf.has("yaw") ? "yaw" : kf.has("quaternion") ? "quaternion" : "time",
+                  "turns " + std::to_string(turn * 180.0 / kPi) +
+                      " degrees since the previous keyframe; interpolation takes the shorter way, "
+                      "so keep each turn under 179 degrees (add keyframes)");
+      }
+      trajectory.keyframes.push_back(keyframe);
+    });
   }
   try {
-    sim::validate(trajectory);
+    if (all_read) sim::validate(trajectory);
   } catch (const std::invalid_argument& e) {
     ctx.fail(node, key, e.what());
   }
@@ -317,25 +356,31 @@ void read_shape(const MapReader& object, sim::PrimitiveSpec& shape, sim::Triangl
                                  : MapReader(ctx, node, key, {"radius", "segments"});
     shape.kind = cylinder ? Kind::Cylinder : Kind::Sphere;
     m.required("radius");
-    shape.radius = m.positive("radius", 0.0);
+    shape.radius = m.number("radius", 0.0);
     if (cylinder) {
       m.required("height");
-      shape.height = m.positive("height", 0.0);
+      shape.height = m.number("height", 0.0);
     }
-    shape.segments = m.integer("segments", shape.segments, 3);
+    shape.segments = m.integer("segments", shape.segments);
   } else {
     const MapReader m(ctx, node, key, {"file", "scale"});
     shape.kind = Kind::Mesh;
     fs::path file = to_text(ctx, m.required("file"), m.sub("file"));
     if (file.is_relative()) file = ctx.dir() / file;
-    const double scale = m.positive("scale", 1.0);
+    const double scale = m.number("scale", 1.0);
     shape.mesh_path = file.lexically_normal().string();
     try {
       mesh = load_mesh(file);
     } catch (const InputError& e) {
       m.fail("file", e.what());
     }
-    for (Eigen::Vector3f& v : mesh.vertices) v *= static_cast<float>(scale);
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+      Eigen::Vector3f& v = mesh.vertices[i];
+      v *= static_cast<float>(scale);
+      if (!v.allFinite() || v.cwiseAbs().maxCoeff() > kMaxPosition)
+        m.fail("file", "vertex " + std::to_string(i) + " lies beyond " + number_text(kMaxPosition) +
+                           " m of the object's origin (or is not finite) at scale " + number_text(scale));
+    }
     return;
   }
   try {
@@ -350,13 +395,15 @@ std::vector<sim::StaticObject> read_statics(const Context& ctx, const YAML::Node
   require_sequence(ctx, node, "static");
   for (std::size_t i = 0; i < node.size(); ++i) {
     const std::string key = item_key("static", i);
-    const MapReader map(ctx, node[i], key,
-                        {"name", "pose", "room", "box", "cylinder", "sphere", "plane", "mesh"});
-    sim::StaticObject object;
-    object.name = map.text("name", key);
-    read_shape(map, object.shape, object.mesh);
-    if (map.has("pose")) object.pose = read_pose(ctx, map.node()["pose"], map.sub("pose"));
-    statics.push_back(std::move(object));
+    ctx.attempt([&] {
+      const MapReader map(ctx, node[i], key,
+                          {"name", "pose", "room", "box", "cylinder", "sphere", "plane", "mesh"});
+      sim::StaticObject object;
+      object.name = map.text("name", key);
+      ctx.attempt([&] { read_shape(map, object.shape, object.mesh); });
+      if (map.has("pose")) object.pose = read_pose(ctx, map.node()["pose"], map.sub("pose"));
+      statics.push_back(std::move(object));
+    });
   }
   return statics;
 }
@@ -366,18 +413,20 @@ std::vector<sim::MovingObject> read_movers(const Context& ctx, const YAML::Node&
   require_sequence(ctx, node, "moving");
   for (std::size_t i = 0; i < node.size(); ++i) {
     const std::string key = item_key("moving", i);
-    const MapReader map(ctx, node[i], key,
-                        {"name", "trajectory", "appear", "disappear", "room", "box", "cylinder",
-                         "sphere", "plane", "mesh"});
-    sim::MovingObject object;
-    object.name = map.text("name", key);
-    read_shape(map, object.shape, object.mesh);
-    object.trajectory = read_trajectory(ctx, map.required("trajectory"), map.sub("trajectory"));
-    object.appear_time = map.number("appear", object.appear_time);
-    object.disappear_time = map.number("disappear", object.disappear_time);
-    if (!(object.appear_time < object.disappear_time))
-      map.fail("disappear", "must be later than appear");
-    movers.push_back(std::move(object));
+    ctx.attempt([&] {
+      const MapReader map(ctx, node[i], key,
+                          {"name", "trajectory", "appear", "disappear", "room", "box", "cylinder",
+                           "sphere", "plane", "mesh"});
+      sim::MovingObject object;
+      object.name = map.text("name", key);
+      ctx.attempt([&] { read_shape(map, object.shape, object.mesh); });
+      object.trajectory = read_trajectory(ctx, map.required("trajectory"), map.sub("trajectory"));
+      object.appear_time = map.number("appear", object.appear_time);
+      object.disappear_time = map.number("disappear", object.disappear_time);
+      if (!(object.appear_time < object.disappear_time))
+        map.fail("disappear", "must be later than appear");
+      movers.push_back(std::move(object));
+    });
   }
   return movers;
 }
@@ -414,15 +463,11 @@ void read_noise(const Context& ctx, const YAML::Node& node, sim::NoiseSpec& nois
   noise.quantisation = m.flag("quantisation", noise.quantisation);
   noise.grazing_invalidation = m.flag("grazing_invalidation", noise.grazing_invalidation);
   noise.edge_invalidation = m.flag("edge_invalidation", noise.edge_invalidation);
-  noise.dropout = m.checked("dropout", noise.dropout,
-                            [](double p) { return p >= 0.0 && p <= 1.0; },
-                            "must be a probability in [0, 1]");
-  noise.baseline = m.positive("baseline", noise.baseline);
-  noise.disparity_step = m.positive("disparity_step", noise.disparity_step);
-  noise.edge_threshold = m.positive("edge_threshold", noise.edge_threshold);
-  noise.grazing_angle = radians(m.checked(
-      "grazing_angle", noise.grazing_angle * 180.0 / kPi,
-      [](double a) { return a > 0.0 && a <= 90.0; }, "must be an angle in (0, 90] degrees"));
+  noise.dropout = m.number("dropout", noise.dropout);
+  noise.baseline = m.number("baseline", noise.baseline);
+  noise.disparity_step = m.number("disparity_step", noise.disparity_step);
+  noise.edge_threshold = m.number("edge_threshold", noise.edge_threshold);
+  noise.grazing_angle = radians(m.number("grazing_angle", noise.grazing_angle * 180.0 / kPi));
 }
 
 // The camera keys shared by a scenario's `sensor` section and a sequence's camera.yaml.
@@ -434,29 +479,31 @@ std::vector<std::string> camera_keys_and(std::vector<std::string> more) {
 
 void read_camera(const MapReader& m, sim::CameraSpec& camera) {
   const Context& ctx = m.ctx();
-  // Larger than any depth camera; keeps a typo from asking for terabytes of image.
-  constexpr int kMaxPixels = 16384;
-  camera.width = m.integer("width", camera.width, 1, kMaxPixels);
-  camera.height = m.integer("height", camera.height, 1, kMaxPixels);
+  camera.width = m.integer("width", camera.width);
+  camera.height = m.integer("height", camera.height);
   if (m.has("intrinsics")) {
     const MapReader in(ctx, m.node()["intrinsics"], m.sub("intrinsics"), {"fx", "fy", "cx", "cy"});
-    camera.fx = in.positive("fx", camera.fx);
-    camera.fy = in.positive("fy", camera.fy);
+    camera.fx = in.number("fx", camera.fx);
+    camera.fy = in.number("fy", camera.fy);
     camera.cx = in.checked("cx", camera.cx, [&](double c) { return c >= 0.0 && c <= camera.width; },
                            "the principal point must lie in the image: 0 <= cx <= width");
     camera.cy = in.checked("cy", camera.cy, [&](double c) { return c >= 0.0 && c <= camera.height; },
                            "the principal point must lie in the image: 0 <= cy <= height");
   }
-  if (camera.cx > camera.width || camera.cy > camera.height)
-    m.fail("intrinsics", "the principal point (cx, cy) lies outside the image; give intrinsics "
-                         "that match width and height");
-  camera.min_range = m.non_negative("min_range", camera.min_range);
+  ctx.attempt([&] {
+    if (camera.cx > camera.width || camera.cy > camera.height)
+      m.fail("intrinsics", "the principal point (cx, cy) lies outside the image; give intrinsics "
+                           "that match width and height");
+  });
+  camera.min_range = m.number("min_range", camera.min_range);
   camera.max_range = m.number("max_range", camera.max_range);
-  if (!(camera.max_range > camera.min_range))
-    m.fail(m.has("max_range") ? "max_range" : "min_range",
-           "max_range (" + std::to_string(camera.max_range) + ") must be greater than min_range (" +
-               std::to_string(camera.min_range) + ")");
-  camera.rate_hz = m.positive("rate", camera.rate_hz);
+  ctx.attempt([&] {
+    if (!(camera.max_range > camera.min_range))
+      m.fail(m.has("max_range") ? "max_range" : "min_range",
+             "max_range (" + std::to_string(camera.max_range) + ") must be greater than min_range (" +
+                 std::to_string(camera.min_range) + ")");
+  });
+  camera.rate_hz = m.number("rate", camera.rate_hz);
   if (m.has("mounting")) {
     // The mounting turns the camera's viewing direction relative to body forward; the optical
     // axes (z forward, x right, y down) follow from the default head mount.
@@ -475,10 +522,10 @@ void read_localisation(const Context& ctx, const YAML::Node& node, sim::Localisa
   const MapReader m(ctx, node, "localisation",
                     {"translation_noise", "yaw_noise", "translation_drift", "yaw_drift",
                      "time_offset"});
-  loc.translation_noise = m.non_negative("translation_noise", loc.translation_noise);
-  loc.yaw_noise = radians(m.non_negative("yaw_noise", loc.yaw_noise));
-  loc.translation_drift = m.non_negative("translation_drift", loc.translation_drift);
-  loc.yaw_drift = radians(m.non_negative("yaw_drift", loc.yaw_drift));
+  loc.translation_noise = m.number("translation_noise", loc.translation_noise);
+  loc.yaw_noise = radians(m.number("yaw_noise", loc.yaw_noise));
+  loc.translation_drift = m.number("translation_drift", loc.translation_drift);
+  loc.yaw_drift = radians(m.number("yaw_drift", loc.yaw_drift));
   loc.time_offset = m.number("time_offset", loc.time_offset);
 }
 
@@ -563,6 +610,19 @@ std::string apply_override(const Context& ctx, YAML::Node& root, const std::stri
   return key;
 }
 
+// `frames`, or `duration` in seconds at `rate_hz`.
+int read_frame_count(const MapReader& top, double rate_hz) {
+  if (top.has("frames") && top.has("duration"))
+    top.fail("duration", "give either frames or duration, not both");
+  if (top.has("frames")) return top.integer("frames", 1);
+  if (!top.has("duration")) top.fail("frames", "missing required key (give frames or duration)");
+  const double frames = std::round(top.number("duration", 1.0 / rate_hz) * rate_hz);
+  if (frames < 1.0 || frames > kMaxFrames)
+    top.fail("duration", "gives " + number_text(frames) + " frames at " + number_text(rate_hz) +
+                             " Hz; need 1 to " + std::to_string(kMaxFrames));
+  return static_cast<int>(frames);
+}
+
 YAML::Node load_yaml(const fs::path& file) {
   const std::string name = file.string();
   std::error_code ec;
@@ -600,36 +660,21 @@ sim::Scenario load_scenario(const fs::path& file, const std::vector<std::string>
   sim::Scenario scenario;
   scenario.source_path = name;
   scenario.name = top.text("name", file.stem().string());
-  if (top.has("seed")) {
-    std::uint64_t seed = 0;
-    if (!root["seed"].IsScalar() || !YAML::convert<std::uint64_t>::decode(root["seed"], seed) ||
-        root["seed"].Scalar().find('-') != std::string::npos)
-      top.fail("seed", "expected a whole number >= 0, got " + describe(root["seed"]));
-    scenario.seed = seed;
-  }
+  if (top.has("seed"))
+    ctx.attempt([&] {
+      if (!root["seed"].IsScalar() || !parse_seed(root["seed"].Scalar(), scenario.seed))
+        top.fail("seed", "expected a whole number in [0, 2^63-1], got " + describe(root["seed"]));
+    });
   scenario.ground_z = top.number("ground_z", scenario.ground_z);
-  if (top.has("sensor")) read_sensor(ctx, root["sensor"], scenario);
-  if (top.has("localisation")) read_localisation(ctx, root["localisation"], scenario.localisation);
-
-  if (top.has("frames") && top.has("duration"))
-    top.fail("duration", "give either frames or duration, not both");
-  if (top.has("frames")) {
-    scenario.frames = top.integer("frames", 0, 1);
-  } else if (top.has("duration")) {
-    const double duration = top.positive("duration", 0.0);
-    const double frames = std::round(duration * scenario.camera.rate_hz);
-    if (frames < 1.0 || frames > INT_MAX)
-      top.fail("duration", "gives " + std::to_string(frames) + " frames at " +
-                               std::to_string(scenario.camera.rate_hz) + " Hz; need at least 1");
-    scenario.frames = static_cast<int>(frames);
-  } else {
-    ctx.fail(root, "frames", "missing required key (give frames or duration)");
-  }
-
-  scenario.body = read_trajectory(ctx, top.required("body"), "body");
-  if (top.has("static")) scenario.statics = read_statics(ctx, root["static"]);
-  if (top.has("moving")) scenario.movers = read_movers(ctx, root["moving"]);
-  check_unique_names(ctx, root, scenario);
+  if (top.has("sensor")) ctx.attempt([&] { read_sensor(ctx, root["sensor"], scenario); });
+  if (top.has("localisation"))
+    ctx.attempt([&] { read_localisation(ctx, root["localisation"], scenario.localisation); });
+  ctx.attempt([&] { scenario.frames = read_frame_count(top, scenario.camera.rate_hz); });
+  ctx.attempt([&] { scenario.body = read_trajectory(ctx, top.required("body"), "body"); });
+  if (top.has("static")) ctx.attempt([&] { scenario.statics = read_statics(ctx, root["static"]); });
+  if (top.has("moving")) ctx.attempt([&] { scenario.movers = read_movers(ctx, root["moving"]); });
+  ctx.attempt([&] { check_unique_names(ctx, root, scenario); });
+  ctx.throw_errors();
   return scenario;
 }
 
@@ -642,7 +687,8 @@ CameraFile load_camera_file(const fs::path& file) {
   CameraFile result;
   result.name = m.text("name", "");
   read_camera(m, result.camera);
-  result.depth_scale = m.positive("depth_scale", result.depth_scale);
+  result.depth_scale = m.number("depth_scale", result.depth_scale);
+  ctx.throw_errors();
   return result;
 }
 
@@ -654,13 +700,7 @@ std::string camera_file_text(const CameraFile& file) {
   const Eigen::Vector3d p = mount.translation();
   std::string out;
   const auto line = [&](const std::string& text) { out += text + "\n"; };
-  // The shortest of 15 or 17 significant digits that reads back exactly.
-  const auto num = [](double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.15g", v);
-    if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
-    return std::string(buf);
-  };
+  const auto num = number_text;  // reads back exactly
   line("# Camera of this sequence (sonomap camera file; format: scenes/README.md).");
   line("# Depth PNG value / depth_scale = z-depth in metres; 0 = no return.");
   if (!file.name.empty()) line("name: " + file.name);

@@ -2,6 +2,7 @@
 #include "harness/formats/tum_io.hpp"
 
 #include "harness/support/errors.hpp"
+#include "harness/support/fields.hpp"
 #include "harness/support/output.hpp"
 
 #include <png.h>
@@ -138,11 +139,13 @@ std::string pose_line(double timestamp, const Eigen::Isometry3d& pose) {
   return line + "\n";
 }
 
-bool parse_number(const std::string& text, double& value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::isfinite(value);
+// Timestamps strictly increase down a file: an unsorted or repeated one is named by its line.
+void check_time_order(const fs::path& file, int line, double time, double& previous) {
+  if (!(time > previous))
+    throw InputError(file.string(), line, "",
+                     "timestamp " + number_text(time) + " is not after the previous one (" +
+                         number_text(previous) + "); timestamps must strictly increase");
+  previous = time;
 }
 
 // Calls `row(line_number, fields)` for each line that is neither empty nor a # comment.
@@ -170,6 +173,7 @@ struct StampedPose {
 
 std::vector<StampedPose> read_groundtruth(const fs::path& file) {
   std::vector<StampedPose> poses;
+  double previous = -INFINITY;
   for_each_row(file, [&](int line, const std::vector<std::string>& words) {
     double v[8];
     bool ok = words.size() == 8;
@@ -177,6 +181,10 @@ std::vector<StampedPose> read_groundtruth(const fs::path& file) {
     if (!ok)
       throw InputError(file.string(), line, "",
                        "expected 8 numbers: timestamp tx ty tz qx qy qz qw");
+    check_time_order(file, line, v[0], previous);
+    if (std::max({std::abs(v[1]), std::abs(v[2]), std::abs(v[3])}) > kMaxPosition)
+      throw InputError(file.string(), line, "",
+                       "position beyond " + number_text(kMaxPosition) + " m of the origin");
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-3)
       throw InputError(file.string(), line, "", "the quaternion qx qy qz qw is not unit length");
@@ -185,8 +193,6 @@ std::vector<StampedPose> read_groundtruth(const fs::path& file) {
     pose.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
     poses.push_back({v[0], pose});
   });
-  std::stable_sort(poses.begin(), poses.end(),
-                   [](const StampedPose& a, const StampedPose& b) { return a.time < b.time; });
   return poses;
 }
 
@@ -275,10 +281,12 @@ TumSequence read_tum_sequence(const fs::path& dir, double max_time_difference) {
   sequence.camera = load_camera_file(dir / "camera.yaml");
   const std::vector<StampedPose> poses = read_groundtruth(dir / "groundtruth.txt");
   const fs::path depth_list = dir / "depth.txt";
+  double previous = -INFINITY;
   for_each_row(depth_list, [&](int line, const std::vector<std::string>& words) {
     TumFrameInfo info;
     if (words.size() != 2 || !parse_number(words[0], info.timestamp))
       throw InputError(depth_list.string(), line, "", "expected: timestamp filename");
+    check_time_order(depth_list, line, info.timestamp, previous);
     info.depth_file = dir / words[1];
     const StampedPose* pose = nearest(poses, info.timestamp, max_time_difference);
     if (!pose) {

@@ -13,43 +13,14 @@
 using sonomap::harness::load_scenario;
 using sonomap::sim::PrimitiveSpec;
 using sonomap::test::input_error_of;
+using sonomap::test::kBase;
+using sonomap::test::with_line;
+using sonomap::test::with_lines;
 using sonomap::test::ScratchDir;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// A valid scenario; the comments give the 1-based line numbers the tests refer to.
-const std::string kBase =
-    "name: probe\n"                                              // 1
-    "frames: 3\n"                                                // 2
-    "sensor:\n"                                                  // 3
-    "  intrinsics: {fx: 525, fy: 525, cx: 319.5, cy: 239.5}\n"   // 4
-    "  min_range: 0.3\n"                                         // 5
-    "  max_range: 5.0\n"                                         // 6
-    "body:\n"                                                    // 7
-    "  interpolation: linear_slerp\n"                            // 8
-    "  keyframes:\n"                                             // 9
-    "    - {time: 0, position: [0, 0, 1.5], yaw: 0}\n"           // 10
-    "    - {time: 1, position: [1, 0, 1.5], yaw: 90}\n"          // 11
-    "static:\n"                                                  // 12
-    "  - name: room\n"                                           // 13
-    "    room: {size: [4, 4, 2.5]}\n";                           // 14
-
-// kBase with lines first..last (1-based) replaced by `text` (which may hold several lines).
-std::string with_lines(int first, int last, const std::string& text) {
-  std::string out;
-  int number = 1;
-  for (std::size_t start = 0; start < kBase.size(); ++number) {
-    const std::size_t end = kBase.find('\n', start);
-    if (number == first) out += text + "\n";
-    if (number < first || number > last) out += kBase.substr(start, end - start + 1);
-    start = end + 1;
-  }
-  return out;
-}
-
-std::string with_line(int line, const std::string& text) { return with_lines(line, line, text); }
 
 // The message names the file, the line and the key.
 void check_located(const std::string& message, const std::string& file, int line,
