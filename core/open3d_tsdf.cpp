@@ -10,6 +10,7 @@
 #include <open3d/geometry/RGBDImage.h>
 #include <open3d/geometry/TriangleMesh.h>
 #include <open3d/pipelines/integration/ScalableTSDFVolume.h>
+#include <open3d/pipelines/integration/UniformTSDFVolume.h>
 
 #include <cmath>
 #include <optional>

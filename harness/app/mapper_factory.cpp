@@ -2,6 +2,7 @@
 #include "harness/app/mapper_factory.hpp"
 
 #include "core/depth_only.hpp"
+#include "core/open3d_tsdf.hpp"
 #include "core/tsdf.hpp"
 #include "core/vdb_gpdf.hpp"
 #include "harness/support/errors.hpp"
@@ -100,18 +101,40 @@ std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& 
   return checked("vdb_gpdf", [&] { return std::make_unique<VdbGpdf>(c); });
 }
 
+// --voxel (when > 0) sets a TSDF's voxel size and keeps its truncation at the same number of voxels.
+void set_voxel_keeping_truncation(double voxel, double& size, double& truncation) {
+  if (voxel <= 0) return;
+  truncation *= voxel / size;
+  size = voxel;
+}
+
 std::unique_ptr<Mapper> make_tsdf(double voxel, const std::vector<Setting>& settings) {
   TsdfConfig c;
-  if (voxel > 0) {
-    c.truncation *= voxel / c.voxel;  // keep the truncation at the same number of voxels
-    c.voxel = voxel;
-  }
+  set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
   FieldTable table{{"voxel", &c.voxel},           {"truncation", &c.truncation},
                    {"carving", &c.space_carving}, {"weight_cap", &c.weight_cap},
                    {"min_weight", &c.min_weight}, {"min_range", &c.min_range},
                    {"max_range", &c.max_range}};
   for (const Setting& s : settings) apply(table, "tsdf", s);
   return checked("tsdf", [&] { return std::make_unique<Tsdf>(c); });
+}
+
+// Open3D's ScalableTSDFVolume with the TSDF peer's voxel and truncation (and the same rule
+// for --voxel), so A/B runs against the reference compare like with like.
+std::unique_ptr<Mapper> make_open3d(double voxel, const std::vector<Setting>& settings) {
+  const TsdfConfig peer;
+  Open3dTsdfConfig c;
+  c.voxel = peer.voxel;
+  c.truncation = peer.truncation;
+  c.min_range = peer.min_range;
+  c.max_range = peer.max_range;
+  set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
+  FieldTable table{{"voxel", &c.voxel},
+                   {"truncation", &c.truncation},
+                   {"min_range", &c.min_range},
+                   {"max_range", &c.max_range}};
+  for (const Setting& s : settings) apply(table, "open3d", s);
+  return checked("open3d", [&] { return std::make_unique<Open3dTsdf>(c); });
 }
 
 std::unique_ptr<Mapper> make_depth_only(const std::vector<Setting>& settings) {
@@ -121,7 +144,7 @@ std::unique_ptr<Mapper> make_depth_only(const std::vector<Setting>& settings) {
 
 }  // namespace
 
-std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "depth_only"}; }
+std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "open3d", "depth_only"}; }
 
 std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
                                     const std::vector<Setting>& settings) {
@@ -129,6 +152,7 @@ std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
     throw InputError("--voxel must be a positive size in metres, got " + std::to_string(voxel));
   if (name == "vdb_gpdf") return make_vdb_gpdf(voxel, settings);
   if (name == "tsdf") return make_tsdf(voxel, settings);
+  if (name == "open3d") return make_open3d(voxel, settings);
   if (name == "depth_only") return make_depth_only(settings);
   std::string names;
   for (const auto& n : mapper_names()) names += (names.empty() ? "" : ", ") + n;

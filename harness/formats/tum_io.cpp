@@ -312,6 +312,7 @@ Frame load_tum_frame(const TumSequence& sequence, std::size_t i) {
   frame.time = info.timestamp - sequence.frames.front().timestamp;
   frame.width = image.width;
   frame.height = image.height;
+  frame.intrinsics = PinholeIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy};
   frame.depth.resize(image.pixels.size(), 0.0f);
   for (int v = 0; v < image.height; ++v) {
     for (int u = 0; u < image.width; ++u) {
