@@ -48,7 +48,11 @@ double lateral_sigma_px(double theta) {
 }
 
 DepthImage jitter_lateral(const DepthImage& in, const NoiseKey& key) {
-  DepthImage out = in;
+  DepthImage out;  // every pixel is written below
+  out.width = in.width;
+  out.height = in.height;
+  out.z.resize(in.z.size());
+  out.incidence.resize(in.incidence.size());
   for_each_row(in.height, [&](int v) {
     RandomStream rng = row_stream(key, StreamPurpose::LateralJitter, v);
     const std::size_t row = static_cast<std::size_t>(v) * in.width;
@@ -84,11 +88,14 @@ void axial_in_place(DepthImage& image, const NoiseKey& key) {
 
 void quantise_in_place(DepthImage& image, double focal_px, double baseline, double step) {
   const double fb = focal_px * baseline;
-  for (float& z : image.z) {
-    if (!(z > 0.0f)) continue;
-    const double steps = std::round(fb / (z * step));
-    z = steps > 0.0 ? static_cast<float>(fb / (steps * step)) : 0.0f;
-  }
+  for_each_row(image.height, [&](int v) {
+    float* row = image.z.data() + static_cast<std::size_t>(v) * image.width;
+    for (int u = 0; u < image.width; ++u) {
+      if (!(row[u] > 0.0f)) continue;
+      const double steps = std::round(fb / (row[u] * step));
+      row[u] = steps > 0.0 ? static_cast<float>(fb / (steps * step)) : 0.0f;
+    }
+  });
 }
 
 void grazing_in_place(DepthImage& image, double max_angle) {
@@ -102,7 +109,7 @@ void edges_in_place(DepthImage& image, const DepthImage& reference, double thres
     const float z = reference.z[static_cast<std::size_t>(v) * w + u];
     return z > 0.0f ? static_cast<double>(z) : HUGE_VAL;
   };
-  for (int v = 0; v < h; ++v)
+  for_each_row(h, [&](int v) {
     for (int u = 0; u < w; ++u) {
       const double z = depth(u, v);
       if (z == HUGE_VAL) continue;
@@ -112,6 +119,7 @@ void edges_in_place(DepthImage& image, const DepthImage& reference, double thres
                         (v + 1 < h && std::abs(depth(u, v + 1) - z) > threshold);
       if (edge) image.z[static_cast<std::size_t>(v) * w + u] = 0.0f;
     }
+  });
 }
 
 void drop_out_in_place(DepthImage& image, double p, const NoiseKey& key) {

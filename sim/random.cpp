@@ -30,7 +30,8 @@ double density(double x) { return std::exp(-0.5 * x * x); }
 
 }  // namespace
 
-RandomStream::RandomStream(std::initializer_list<std::uint64_t> key) : state_(mix_key(key)) {}
+RandomStream::RandomStream(std::initializer_list<std::uint64_t> key)
+    : table_(&ziggurat()), state_(mix_key(key)) {}
 
 const RandomStream::Ziggurat& RandomStream::ziggurat() {
   // Built once (thread-safe static initialisation) from exp, log and sqrt only.
@@ -50,7 +51,7 @@ const RandomStream::Ziggurat& RandomStream::ziggurat() {
 // The rare cases: the base layer's tail beyond R (Marsaglia 1964), or a layer's wedge
 // (accepted under the density, else a fresh sample).
 double RandomStream::normal_slow(unsigned layer, double u) {
-  const Ziggurat& z = ziggurat();
+  const Ziggurat& z = *table_;
   for (;;) {
     if (layer == 0) {
       double x, y;

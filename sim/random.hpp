@@ -45,8 +45,7 @@ class RandomStream {
     const unsigned layer = static_cast<unsigned>(r & 127u);
     // u in [-1, 1) from the 53 high bits; the low 7 bits chose the layer.
     const double u = static_cast<double>(r >> 11) * 0x1.0p-52 - 1.0;
-    const Ziggurat& z = ziggurat();
-    if (u * u < z.ratio2[layer]) return u * z.x[layer];  // inside the layer's inner rectangle
+    if (u * u < table_->ratio2[layer]) return u * table_->x[layer];  // the layer's inner rectangle
     return normal_slow(layer, u);
   }
   double normal(double sigma) { return sigma * normal(); }
@@ -61,6 +60,7 @@ class RandomStream {
   static const Ziggurat& ziggurat();
   double normal_slow(unsigned layer, double u);
 
+  const Ziggurat* table_;  // ziggurat(), looked up once per stream
   std::uint64_t state_;
 };
 
