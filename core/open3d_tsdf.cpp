@@ -114,7 +114,7 @@ void Open3dTsdf::integrate(const Frame& frame) {
   auto t0 = StageClock::now();
   const open3d::camera::PinholeCameraIntrinsic intrinsic(frame.width, frame.height, k.fx, k.fy, k.cx, k.cy);
   // Open3D's extrinsic is camera_T_world; its camera frame (x right, y down, z forward) is
-  // our optical frame.
+  // our optical frame (docs/conventions.md).
   volume_->tsdf.Integrate(volume_->image, intrinsic, frame.world_T_camera.inverse().matrix());
   volume_->surface_stale = true;
   times_.stages.emplace_back("convert", convert_ms);
