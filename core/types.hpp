@@ -5,10 +5,21 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 namespace sonomap {
+
+// Pinhole intrinsics of a depth image, in pixels: pixel (u, v) at depth z is the optical-frame
+// point ((u - cx) z / fx, (v - cy) z / fy, z). All zero when the source gave none.
+struct PinholeIntrinsics {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  bool valid() const {
+    return std::isfinite(fx) && std::isfinite(fy) && fx > 0.0 && fy > 0.0 && std::isfinite(cx) &&
+           std::isfinite(cy);
+  }
+};
 
 // One depth frame as the mapper sees it.
 struct Frame {
@@ -19,6 +30,7 @@ struct Frame {
   // Row-major z-depth in metres, width*height values. 0 means "no return" (out of range,
   // invalidated by the noise model, or nothing hit). Never NaN.
   std::vector<float> depth;
+  PinholeIntrinsics intrinsics;  // of `depth` (projective integrators need them)
   // The valid pixels back-projected into the camera optical frame (x right, y down, z forward).
   std::vector<Eigen::Vector3f> points_camera;
   // Camera pose in the world as handed to the mapper (localisation estimate) ...

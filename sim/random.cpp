@@ -21,25 +21,56 @@ std::uint64_t mix_key(std::initializer_list<std::uint64_t> key) {
   return h;
 }
 
+// Doornik (2005): R, the start of the tail, and V, the area of each of the 128 layers
+// (the base layer includes the tail beyond R).
+constexpr double kTailStart = 3.442619855899;
+constexpr double kLayerArea = 9.91256303526217e-3;
+
+double density(double x) { return std::exp(-0.5 * x * x); }
+
 }  // namespace
 
-RandomStream::RandomStream(std::initializer_list<std::uint64_t> key) : engine_(mix_key(key)) {}
+RandomStream::RandomStream(std::initializer_list<std::uint64_t> key)
+    : table_(&ziggurat()), state_(mix_key(key)) {}
 
-double RandomStream::normal() {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_;
+const RandomStream::Ziggurat& RandomStream::ziggurat() {
+  // Built once (thread-safe static initialisation) from exp, log and sqrt only.
+  static const Ziggurat table = [] {
+    Ziggurat z{};
+    z.x[0] = kLayerArea / density(kTailStart);  // the base layer's equivalent width
+    z.x[1] = kTailStart;
+    for (int i = 2; i < 128; ++i)
+      z.x[i] = std::sqrt(-2.0 * std::log(kLayerArea / z.x[i - 1] + density(z.x[i - 1])));
+    z.x[128] = 0.0;
+    for (int i = 0; i < 128; ++i) z.ratio2[i] = (z.x[i + 1] / z.x[i]) * (z.x[i + 1] / z.x[i]);
+    return z;
+  }();
+  return table;
+}
+
+// The rare cases: the base layer's tail beyond R (Marsaglia 1964), or a layer's wedge
+// (accepted under the density, else a fresh sample).
+double RandomStream::normal_slow(unsigned layer, double u) {
+  const Ziggurat& z = *table_;
+  for (;;) {
+    if (layer == 0) {
+      double x, y;
+      do {
+        x = std::log(1.0 - uniform()) / kTailStart;  // 1 - uniform() is in (0, 1]
+        y = std::log(1.0 - uniform());
+      } while (-2.0 * y < x * x);
+      return u < 0.0 ? x - kTailStart : kTailStart - x;
+    }
+    const double x = u * z.x[layer];
+    const double f0 = std::exp(-0.5 * (z.x[layer] * z.x[layer] - x * x));
+    const double f1 = std::exp(-0.5 * (z.x[layer + 1] * z.x[layer + 1] - x * x));
+    if (f1 + uniform() * (f0 - f1) < 1.0) return x;
+    // Rejected: a fresh draw, the same as normal() (which may take the fast path).
+    const std::uint64_t r = bits();
+    layer = static_cast<unsigned>(r & 127u);
+    u = static_cast<double>(r >> 11) * 0x1.0p-52 - 1.0;
+    if (u * u < z.ratio2[layer]) return u * z.x[layer];
   }
-  double u, v, s;
-  do {
-    u = 2.0 * uniform() - 1.0;
-    v = 2.0 * uniform() - 1.0;
-    s = u * u + v * v;
-  } while (s >= 1.0 || s == 0.0);
-  const double factor = std::sqrt(-2.0 * std::log(s) / s);
-  spare_ = v * factor;
-  has_spare_ = true;
-  return u * factor;
 }
 
 }  // namespace sonomap::sim

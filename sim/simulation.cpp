@@ -127,6 +127,8 @@ Frame Simulation::render(int frame) {
   out.time = t;
   out.width = scenario_.camera.width;
   out.height = scenario_.camera.height;
+  const CameraSpec& c = scenario_.camera;
+  out.intrinsics = PinholeIntrinsics{c.fx, c.fy, c.cx, c.cy};
   out.world_T_body_true = true_body_pose(t);
   out.world_T_camera_true = out.world_T_body_true * scenario_.camera.body_T_camera;
   out.world_T_body = localisation_->estimated_body_pose(scenario_.body, frame, t);

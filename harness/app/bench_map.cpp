@@ -8,6 +8,7 @@
 
 #include "core/rasteriser.hpp"
 #include "core/stopwatch.hpp"
+#include "core/tsdf.hpp"
 #include "harness/app/mapper_factory.hpp"
 #include "harness/app/run.hpp"
 #include "harness/formats/scenario_yaml.hpp"
@@ -19,20 +20,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <omp.h>
-#include <open3d/camera/PinholeCameraIntrinsic.h>
-#include <open3d/geometry/Image.h>
 #include <open3d/geometry/KDTreeFlann.h>
-#include <open3d/geometry/RGBDImage.h>
-#include <open3d/geometry/TriangleMesh.h>
-#include <open3d/pipelines/integration/ScalableTSDFVolume.h>
-#include <open3d/pipelines/integration/UniformTSDFVolume.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -44,12 +38,12 @@ namespace sonomap::harness {
 
 namespace {
 
-namespace integration = open3d::pipelines::integration;
 using nlohmann::json;
 
+// The reference: the `open3d` mapper (Open3D's ScalableTSDFVolume, with the TSDF peer's voxel
+// and truncation), run like every other mapper; its ratios use its fusion time ("map").
 constexpr const char* kOpen3d = "open3d";
-// Open3D's truncation in voxels: the same as our TSDF peer's default (0.15 m at 0.05 m).
-constexpr double kOpen3dTruncationVoxels = 3.0;
+const TsdfConfig kPeer;  // the open3d mapper's defaults (voxel, truncation, ranges) are the TSDF peer's
 
 struct BenchMapOptions {
   std::string scenario = "scenes/room.yaml";
@@ -65,22 +59,14 @@ struct BenchMapOptions {
 // Stage name and wall time in ms, in the order the stages ran.
 using StageList = std::vector<std::pair<std::string, double>>;
 
-// A map under test: fuses one frame and reports the time of each of its stages. Every map
-// reports "map" (the whole fusion) and "frame" (everything a frame costs, rasters included).
-class BenchedMap {
+// A mapper under test, followed by the circle and cylinder exactly as `run` builds them. It
+// reports its own stages, "map" (the whole fusion), "raster" and "frame" (map + raster).
+class TimedMap {
  public:
-  virtual ~BenchedMap() = default;
-  virtual void process(const Frame& frame, StageList& stages) = 0;
-  virtual size_t memory_bytes() const = 0;
-};
-
-// One of our mappers, followed by the circle and cylinder exactly as `run` builds them.
-class OurMap final : public BenchedMap {
- public:
-  OurMap(std::unique_ptr<Mapper> mapper, double ground_z)
+  TimedMap(std::unique_ptr<Mapper> mapper, double ground_z)
       : mapper_(std::move(mapper)), ground_z_(ground_z) {}
 
-  void process(const Frame& frame, StageList& stages) override {
+  void process(const Frame& frame, StageList& stages) {
     auto t0 = StageClock::now();
     mapper_->integrate(frame);
     const double map_ms = ms_since(t0);
@@ -93,7 +79,6 @@ class OurMap final : public BenchedMap {
     stages.emplace_back("map", map_ms);
     stages.emplace_back("frame", map_ms + raster_ms);
   }
-  size_t memory_bytes() const override { return mapper_->memory_bytes(); }
   const Mapper& mapper() const { return *mapper_; }
 
  private:
@@ -101,58 +86,6 @@ class OurMap final : public BenchedMap {
   double ground_z_;
   Rasteriser rasteriser_;
   std::vector<Eigen::Vector3f> surface_;
-};
-
-// The reference: Open3D's ScalableTSDFVolume (16^3 voxel units, no colour). Its timed cost is
-// the whole hand-over of a frame, as our mappers' is: copying our depth image into an Open3D
-// image and building the RGBDImage ("convert"), then Integrate (back-projection included).
-class Open3dMap final : public BenchedMap {
- public:
-  Open3dMap(double voxel, const sim::CameraSpec& camera)
-      : volume_(voxel, kOpen3dTruncationVoxels * voxel, integration::TSDFVolumeColorType::NoColor),
-        intrinsic_(camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy),
-        depth_trunc_(camera.max_range) {
-    colour_.Prepare(camera.width, camera.height, 1, 1);  // Open3D wants one; NoColor ignores it
-  }
-
-  void process(const Frame& frame, StageList& stages) override {
-    if (frame.depth.size() != static_cast<size_t>(intrinsic_.width_) * intrinsic_.height_)
-      throw std::runtime_error(fmt::format("bench map: frame {} has {} depth pixels, the camera {}x{}",
-                                           frame.index, frame.depth.size(), intrinsic_.width_,
-                                           intrinsic_.height_));
-    auto t0 = StageClock::now();
-    open3d::geometry::Image depth;
-    depth.Prepare(frame.width, frame.height, 1, 4);  // float metres, 0 = no return
-    std::memcpy(depth.data_.data(), frame.depth.data(), frame.depth.size() * sizeof(float));
-    const auto rgbd = open3d::geometry::RGBDImage::CreateFromColorAndDepth(
-        colour_, depth, /*depth_scale=*/1.0, depth_trunc_, /*convert_rgb_to_intensity=*/false);
-    const double convert_ms = ms_since(t0);
-    t0 = StageClock::now();
-    // Open3D's extrinsic is camera_T_world; its camera frame (x right, y down, z forward) is
-    // our optical frame (docs/conventions.md).
-    volume_.Integrate(*rgbd, intrinsic_, frame.world_T_camera.inverse().matrix());
-    const double integrate_ms = ms_since(t0);
-    stages.emplace_back("convert", convert_ms);
-    stages.emplace_back("integrate", integrate_ms);
-    stages.emplace_back("map", convert_ms + integrate_ms);
-    stages.emplace_back("frame", convert_ms + integrate_ms);
-  }
-
-  // The voxel storage of the allocated units (the hash map's own nodes are not counted).
-  size_t memory_bytes() const override {
-    size_t bytes = 0;
-    for (const auto& unit : volume_.volume_units_)
-      bytes += unit.second.volume_->voxels_.capacity() * sizeof(open3d::geometry::TSDFVoxel);
-    return bytes;
-  }
-
-  std::vector<Eigen::Vector3d> mesh_vertices() { return volume_.ExtractTriangleMesh()->vertices_; }
-
- private:
-  integration::ScalableTSDFVolume volume_;
-  open3d::camera::PinholeCameraIntrinsic intrinsic_;
-  double depth_trunc_;
-  open3d::geometry::Image colour_;
 };
 
 // One (voxel, threads, mapper) cell: per-frame samples of every stage.
@@ -164,8 +97,9 @@ struct CellResult {
   std::map<std::string, std::vector<double>> samples;
   std::vector<double> frame_cpu_ms;  // process CPU time of the whole frame (all threads)
   size_t peak_map_bytes = 0;
-  double frame_ratio = NAN;  // median frame / Open3D's median frame in the same cell
-  double map_ratio = NAN;    // the same for the fusion alone
+  // Ratios to the reference's fusion: median frame (or map) / Open3D's median map in the same cell.
+  double frame_ratio = NAN;
+  double map_ratio = NAN;
 
   double median_of(const std::string& stage) const { return median(samples.at(stage)); }
 };
@@ -181,7 +115,7 @@ struct ReferenceCheck {
   bool passed() const { return open3d_vertices > 0 && median_distance < voxel; }
 };
 
-double median_nearest_distance(const std::vector<Eigen::Vector3d>& from,
+double median_nearest_distance(const std::vector<Eigen::Vector3f>& from,
                                const std::vector<Eigen::Vector3f>& to) {
   if (from.empty() || to.empty()) return NAN;
   Eigen::MatrixXd points(3, static_cast<Eigen::Index>(to.size()));
@@ -191,8 +125,8 @@ double median_nearest_distance(const std::vector<Eigen::Vector3d>& from,
   distances.reserve(from.size());
   std::vector<int> index;
   std::vector<double> distance2;
-  for (const Eigen::Vector3d& p : from)
-    if (tree.SearchKNN(p, 1, index, distance2) == 1) distances.push_back(std::sqrt(distance2[0]));
+  for (const Eigen::Vector3f& p : from)
+    if (tree.SearchKNN(Eigen::Vector3d(p.cast<double>()), 1, index, distance2) == 1) distances.push_back(std::sqrt(distance2[0]));
   return distances.empty() ? NAN : median(std::move(distances));
 }
 
@@ -217,10 +151,10 @@ void check_options(const BenchMapOptions& o) {
     if (t < 1) throw InputError(fmt::format("--threads-list: a thread count must be at least 1, got {}", t));
   for (const std::string& m : o.mappers) {
     const auto names = mapper_names();
-    if (m != kOpen3d && std::find(names.begin(), names.end(), m) == names.end()) {
+    if (std::find(names.begin(), names.end(), m) == names.end()) {
       std::string known;
-      for (const auto& n : names) known += n + ", ";
-      throw InputError("--mappers " + m + ": unknown mapper (known: " + known + kOpen3d + ")");
+      for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw InputError("--mappers " + m + ": unknown mapper (known: " + known + ")");
     }
   }
   if (!o.json.empty()) {
@@ -246,7 +180,7 @@ CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scen
                      int threads, const std::string& mapper, Progress& progress, long& done,
                      std::optional<ReferenceCheck>& check,
                      std::vector<Eigen::Vector3f>& tsdf_surface,
-                     std::vector<Eigen::Vector3d>& open3d_vertices) {
+                     std::vector<Eigen::Vector3f>& open3d_vertices) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // Open3D's own OpenMP loops: their num_threads() clause follows omp_get_max_threads() only
   // when OMP_NUM_THREADS is set (otherwise they take every core), so set both.
@@ -257,18 +191,14 @@ CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scen
   cell.threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
   cell.mapper = mapper;
 
-  std::unique_ptr<BenchedMap> map;
-  if (mapper == kOpen3d)
-    map = std::make_unique<Open3dMap>(voxel, scenario.camera);
-  else
-    map = std::make_unique<OurMap>(make_mapper(mapper, voxel, {}), scenario.ground_z);
+  TimedMap map(make_mapper(mapper, voxel, {}), scenario.ground_z);
 
   StageList stages;
   for (const Frame& frame : frames) {
     stages.clear();
     const double cpu_start = process_cpu_ms();
     try {
-      map->process(frame, stages);
+      map.process(frame, stages);
     } catch (const std::invalid_argument& e) {
       throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
     }
@@ -277,7 +207,7 @@ CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scen
       if (!cell.samples.count(name)) cell.stage_order.push_back(name);
       cell.samples[name].push_back(ms);
     }
-    cell.peak_map_bytes = std::max(cell.peak_map_bytes, map->memory_bytes());
+    cell.peak_map_bytes = std::max(cell.peak_map_bytes, map.mapper().memory_bytes());
     progress.update(++done);
   }
 
@@ -289,10 +219,10 @@ CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scen
     const Eigen::Vector3d centre = frames.front().world_T_camera.translation();
     double reach = 0.0;
     for (const Frame& f : frames) reach = std::max(reach, (f.world_T_camera.translation() - centre).norm());
-    static_cast<const OurMap&>(*map).mapper().surface_points(
-        centre, reach + scenario.camera.max_range + 1.0, tsdf_surface);
+    map.mapper().surface_points(centre, reach + scenario.camera.max_range + 1.0, tsdf_surface);
   } else if (mapper == kOpen3d) {
-    open3d_vertices = static_cast<Open3dMap&>(*map).mesh_vertices();
+    std::vector<Eigen::Vector3i> triangles;
+    map.mapper().surface_mesh(open3d_vertices, triangles);
   }
   if ((mapper == "tsdf" || mapper == kOpen3d) && !tsdf_surface.empty() && !open3d_vertices.empty()) {
     check = ReferenceCheck{voxel, cell.threads, open3d_vertices.size(), tsdf_surface.size(),
@@ -319,11 +249,13 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
            {"every", o.every},
            {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
            {"open3d", {{"class", "ScalableTSDFVolume"},
-                       {"sdf_trunc_voxels", kOpen3dTruncationVoxels},
-                       {"depth_trunc_m", scenario.camera.max_range},
+                       {"sdf_trunc_voxels", kPeer.truncation / kPeer.voxel},
+                       {"range_m", {kPeer.min_range, kPeer.max_range}},
                        {"omp_wait_policy",
                         omp_wait_policy() ? omp_wait_policy() : "unset (libgomp: spin, then sleep)"},
-                       {"timed", "depth image copy + RGBDImage::CreateFromColorAndDepth + Integrate"}}},
+                       {"timed", "the open3d mapper's integrate: depth image copy with the range "
+                                 "limits + Integrate"},
+                       {"ratios", "to open3d's median map (fusion) in the same (voxel, threads) cell"}}},
            {"results", json::array()},
            {"open3d_checks", json::array()},
            {"peak_rss_mb", rss_peak_mb},
@@ -371,7 +303,7 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   for (double voxel : o.voxels)
     for (int threads : o.threads) {
       std::vector<Eigen::Vector3f> tsdf_surface;
-      std::vector<Eigen::Vector3d> open3d_vertices;
+      std::vector<Eigen::Vector3f> open3d_vertices;
       std::optional<ReferenceCheck> check;
       for (const std::string& mapper : o.mappers)
         results.push_back(time_cell(frames, scenario, voxel, threads, mapper, progress, done, check,
@@ -385,18 +317,18 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   for (CellResult& cell : results)
     for (const CellResult& ref : results)
       if (ref.mapper == kOpen3d && ref.voxel == cell.voxel && ref.threads == cell.threads) {
-        cell.frame_ratio = cell.median_of("frame") / ref.median_of("frame");
+        cell.frame_ratio = cell.median_of("frame") / ref.median_of("map");
         cell.map_ratio = cell.median_of("map") / ref.median_of("map");
       }
 
   fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), medians per frame in ms\n",
              scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every);
-  fmt::print("map = the mapper's integrate (open3d: depth copy + RGBDImage + Integrate, truncation "
-             "{:g} voxels); raster = circle + cylinder\nfrom the map's surface samples (as `run`); "
-             "frame = map + raster; cpu = process CPU time of the frame (all threads);\n"
-             "frame/o3d, map/o3d = ratios of the medians to open3d's in the same (voxel, threads) "
-             "cell.\n",
-             kOpen3dTruncationVoxels);
+  fmt::print("map = the mapper's integrate (open3d: depth copy + Integrate, truncation {:g} voxels); "
+             "raster = circle + cylinder\nfrom the map's surface samples (as `run`; open3d: mesh "
+             "extraction included); frame = map + raster;\ncpu = process CPU time of the frame (all "
+             "threads); frame/o3d, map/o3d = ratios of the medians to open3d's map\n(its fusion) in "
+             "the same (voxel, threads) cell.\n",
+             kPeer.truncation / kPeer.voxel);
   const auto ms = [](double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : std::string("-"); };
   fmt::print("{:>6} {:>3} {:<10} {:>6} | {:>9} {:>9} {:>9} {:>9} | {:>9} {:>9} | {:>9} | {}\n", "voxel",
              "thr", "mapper", "frames", "frame", "cpu", "map", "raster", "frame/o3d", "map/o3d",

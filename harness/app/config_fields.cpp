@@ -64,6 +64,16 @@ FieldTable tsdf_fields(TsdfConfig& c) {
   };
 }
 
+FieldTable open3d_fields(Open3dTsdfConfig& c) {
+  return {
+      number("voxel", &c.voxel, "m", kMinVoxel, kMaxVoxel, "voxel size (`--voxel`)"),
+      positive("truncation", &c.truncation, "m", kMaxVoxel * 10,
+               "truncation distance (`--voxel` keeps it at 3 voxels)"),
+      number("min_range", &c.min_range, "m", 0.0, kMaxRange, "points nearer the camera are ignored"),
+      positive("max_range", &c.max_range, "m", kMaxRange, "points farther from the camera are ignored"),
+  };
+}
+
 FieldTable raster_fields(RasterConfig& c) {
   return {
       whole("azimuth_bins", &c.azimuth_bins, 1, 36000, "bins over 360 degrees"),

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/edf_raster.hpp"
+#include "core/open3d_tsdf.hpp"
 #include "core/raster.hpp"
 #include "core/tsdf.hpp"
 #include "core/vdb_gpdf.hpp"
@@ -15,6 +16,7 @@ namespace sonomap::harness {
 
 FieldTable vdb_gpdf_fields(VdbGpdfConfig& c);
 FieldTable tsdf_fields(TsdfConfig& c);
+FieldTable open3d_fields(Open3dTsdfConfig& c);
 FieldTable raster_fields(RasterConfig& c);
 FieldTable metrics_fields(eval::MetricsConfig& c);
 FieldTable edf_raster_fields(EdfRasterConfig& c);

@@ -2,6 +2,7 @@
 #include "harness/app/mapper_factory.hpp"
 
 #include "core/depth_only.hpp"
+#include "core/open3d_tsdf.hpp"
 #include "harness/app/config_fields.hpp"
 #include "harness/support/errors.hpp"
 
@@ -38,14 +39,37 @@ std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& 
   return checked("vdb_gpdf", [&] { return std::make_unique<VdbGpdf>(c); });
 }
 
+// --voxel (when > 0) sets a TSDF's voxel size and keeps its truncation at the same number of voxels.
+void set_voxel_keeping_truncation(double voxel, double& size, double& truncation) {
+  if (voxel <= 0) return;
+  truncation *= voxel / size;
+  size = voxel;
+}
+
 std::unique_ptr<Mapper> make_tsdf(double voxel, const std::vector<Setting>& settings) {
   TsdfConfig c;
-  if (voxel > 0) {
-    c.truncation *= voxel / c.voxel;  // keep the truncation at the same number of voxels
-    c.voxel = voxel;
-  }
+  set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
   apply(tsdf_fields(c), "tsdf", settings);
   return checked("tsdf", [&] { return std::make_unique<Tsdf>(c); });
+}
+
+// Open3D's ScalableTSDFVolume with the TSDF peer's voxel and truncation (and the same rule
+// for --voxel), so A/B runs against the reference compare like with like.
+Open3dTsdfConfig open3d_defaults() {
+  const TsdfConfig peer;
+  Open3dTsdfConfig c;
+  c.voxel = peer.voxel;
+  c.truncation = peer.truncation;
+  c.min_range = peer.min_range;
+  c.max_range = peer.max_range;
+  return c;
+}
+
+std::unique_ptr<Mapper> make_open3d(double voxel, const std::vector<Setting>& settings) {
+  Open3dTsdfConfig c = open3d_defaults();
+  set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
+  apply(open3d_fields(c), "open3d", settings);
+  return checked("open3d", [&] { return std::make_unique<Open3dTsdf>(c); });
 }
 
 // Calls `use(name, table)` with each mapper's table over a config of its defaults.
@@ -55,11 +79,13 @@ void for_each_default_table(Use use) {
   use("vdb_gpdf", vdb_gpdf_fields(vdb));
   TsdfConfig tsdf;
   use("tsdf", tsdf_fields(tsdf));
+  Open3dTsdfConfig open3d = open3d_defaults();
+  use("open3d", open3d_fields(open3d));
 }
 
 }  // namespace
 
-std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "depth_only"}; }
+std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "open3d", "depth_only"}; }
 
 std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
                                     const std::vector<Setting>& settings) {
@@ -68,6 +94,7 @@ std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
                      number_text(kMinVoxel) + ", " + number_text(kMaxVoxel) + "] m");
   if (name == "vdb_gpdf") return make_vdb_gpdf(voxel, settings);
   if (name == "tsdf") return make_tsdf(voxel, settings);
+  if (name == "open3d") return make_open3d(voxel, settings);
   if (name == "depth_only") {
     apply({}, name, settings);
     return std::make_unique<DepthOnlyMapper>();
@@ -88,6 +115,9 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
   } else if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) {
     TsdfConfig c = t->config();
     add(tsdf_fields(c));
+  } else if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) {
+    Open3dTsdfConfig c = o->config();
+    add(open3d_fields(c));
   }
   return entries;
 }
@@ -95,6 +125,7 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
 double mapper_voxel(const Mapper& mapper) {
   if (const auto* v = dynamic_cast<const VdbGpdf*>(&mapper)) return v->config().global_voxel;
   if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) return t->config().voxel;
+  if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) return o->config().voxel;
   return 0.0;
 }
 

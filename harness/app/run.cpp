@@ -428,7 +428,8 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--every", options->every,
                   "Evaluate rasters, truth and metrics every K-th frame (and the last)")
       ->check(CLI::Range(1, kMaxFrames))->capture_default_str();
-  cmd->add_option("--mapper", options->mapper, "Mapper: vdb_gpdf, tsdf or depth_only")
+  cmd->add_option("--mapper", options->mapper,
+                  "Mapper: vdb_gpdf, tsdf, open3d (Open3D's ScalableTSDFVolume) or depth_only")
       ->capture_default_str();
   cmd->add_option("--voxel", options->voxel, "Global voxel size in metres (default: the mapper's)")
       ->check(CLI::Range(kMinVoxel, kMaxVoxel));

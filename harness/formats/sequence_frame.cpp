@@ -19,6 +19,7 @@ Frame frame_from_record(int index, const DepthRecord& record, double time_zero,
   frame.time = record.time - time_zero;
   frame.width = record.width;
   frame.height = record.height;
+  frame.intrinsics = PinholeIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy};
   frame.depth.assign(record.depth.size(), 0.0f);
   for (int v = 0; v < record.height; ++v) {
     for (int u = 0; u < record.width; ++u) {

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The random streams against closed forms: the normal sampler's distribution function (erfc),
+// moments of both samplers, and streams that depend only on their key.
+#include "sim/random.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+using namespace sonomap::sim;
+
+namespace {
+
+// Standard normal distribution function, independent of the sampler: Phi(x) = erfc(-x / sqrt 2) / 2.
+double phi(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+}  // namespace
+
+TEST_CASE("normal samples follow Phi at every layer, the wedges and the tail", "[sim][random]") {
+  RandomStream rng({2024, 0, 7, 99});
+  const int n = 2'000'000;
+  std::vector<double> x(n);
+  for (double& v : x) v = rng.normal();
+  double sum = 0.0, sum2 = 0.0, sum4 = 0.0;
+  for (double v : x) sum += v, sum2 += v * v, sum4 += v * v * v * v;
+  const double mean = sum / n, var = sum2 / n - mean * mean;
+  CHECK(std::abs(mean) < 5.0 / std::sqrt(n));
+  CHECK(var == Approx(1.0).margin(5.0 * std::sqrt(2.0 / n)));        // var of s^2: 2 / n
+  CHECK(sum4 / n == Approx(3.0).margin(5.0 * std::sqrt(96.0 / n)));  // E x^4 = 3, var 96 / n
+  // The fraction below t, for t across the body, the wedges and the tail beyond 3.44: within 5
+  // binomial standard errors of Phi(t).
+  for (double t : {-4.0, -3.5, -3.0, -2.0, -1.3, -0.7, -0.2, 0.0, 0.1, 0.5, 1.0, 1.7, 2.5, 3.2, 3.6, 4.2}) {
+    long below = 0;
+    for (double v : x) below += v < t;
+    const double p = phi(t), se = std::sqrt(p * (1.0 - p) / n);
+    INFO("t = " << t);
+    CHECK(static_cast<double>(below) / n == Approx(p).margin(5.0 * se + 1e-7));
+  }
+}
+
+TEST_CASE("uniform samples have mean 1/2 and variance 1/12; streams depend only on their key",
+          "[sim][random]") {
+  RandomStream rng({1, 2, 3});
+  const int n = 1'000'000;
+  double sum = 0.0, sum2 = 0.0, lo = 1.0, hi = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double u = rng.uniform();
+    sum += u, sum2 += u * u;
+    lo = std::min(lo, u), hi = std::max(hi, u);
+  }
+  const double mean = sum / n;
+  CHECK(mean == Approx(0.5).margin(5.0 * std::sqrt(1.0 / 12.0 / n)));
+  CHECK(sum2 / n - mean * mean == Approx(1.0 / 12.0).margin(5.0 * std::sqrt(1.0 / 180.0 / n)));
+  CHECK(lo >= 0.0);
+  CHECK(hi < 1.0);
+
+  RandomStream a({5, 0, 9, 1}), b({5, 0, 9, 1}), c({5, 0, 9, 2});
+  bool same = true, differ = false;
+  for (int i = 0; i < 1000; ++i) {
+    const double x = a.normal(), y = b.normal(), z = c.normal();
+    same = same && x == y;
+    differ = differ || x != z;
+  }
+  CHECK(same);
+  CHECK(differ);
+}
