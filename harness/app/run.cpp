@@ -198,7 +198,8 @@ RunOutcome run_scenario(const RunOptions& options) {
     throw_if_interrupted();
     std::vector<std::pair<std::string, double>> times;
     auto t0 = Clock::now();
-    const Frame frame = source->frame(i);
+    const SourceFrame sensed = source->frame(i);  // the truth stays here, away from the mapper
+    const Frame& frame = sensed.frame;
     times.emplace_back("render", ms_since(t0));
 
     t0 = Clock::now();
@@ -227,7 +228,7 @@ RunOutcome run_scenario(const RunOptions& options) {
       my.estimate_known = rasteriser.cylinder().known_count();
       if (has_truth) {
         t0 = Clock::now();
-        const RasterOrigin true_origin = raster_origin(frame.world_T_body_true, source->ground_z());
+        const RasterOrigin true_origin = raster_origin(sensed.world_T_body_true, source->ground_z());
         truth = eval::ground_truth_rasters(*source->truth(frame.time), true_origin, settings.raster);
         times.emplace_back("truth", ms_since(t0));
         mc = eval::compare(rasteriser.circle(), truth.circle, settings.metrics);
@@ -263,7 +264,7 @@ RunOutcome run_scenario(const RunOptions& options) {
       }
       ++evaluated;
       frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ','
-                 << pose_csv(frame.world_T_body_true);
+                 << pose_csv(sensed.world_T_body_true);
       for (const RasterMetrics* m : {&mc, &my})
         frames_csv << ',' << csv_number(m->coverage) << ',' << csv_number(m->rmse) << ','
                    << csv_number(m->rmse_off_edges) << ','

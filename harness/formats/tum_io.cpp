@@ -244,7 +244,7 @@ TumWriter::TumWriter(fs::path dir, CameraFile camera)
   groundtruth_ = "# ground truth trajectory\n" + origin + "# timestamp tx ty tz qx qy qz qw\n";
 }
 
-void TumWriter::add(const Frame& frame) {
+void TumWriter::add(const Frame& frame, const Eigen::Isometry3d& world_T_camera_true) {
   DepthImage16 image;
   image.width = frame.width;
   image.height = frame.height;
@@ -257,7 +257,7 @@ void TumWriter::add(const Frame& frame) {
   const std::string name = "depth/" + stamp + ".png";
   write_png16(dir_ / name, image);
   depth_list_ += stamp + " " + name + "\n";
-  groundtruth_ += pose_line(frame.time, frame.world_T_camera_true);
+  groundtruth_ += pose_line(frame.time, world_T_camera_true);
 }
 
 void TumWriter::finish() {
@@ -325,9 +325,7 @@ Frame load_tum_frame(const TumSequence& sequence, std::size_t i) {
     }
   }
   frame.world_T_camera = info.world_T_camera;
-  frame.world_T_camera_true = info.world_T_camera;
   frame.world_T_body = info.world_T_camera * camera.body_T_camera.inverse();
-  frame.world_T_body_true = frame.world_T_body;
   return frame;
 }
 
