@@ -60,9 +60,9 @@ TEST_CASE("a rendered TUM sequence gives the simulator's circle within the depth
   recorded.scenario = tum;
   recorded.out = scratch.path() / "recorded";
   recorded.overrides.clear();
-  const nlohmann::json summary = sonomap::harness::run_scenario(recorded).summary;
-  CHECK(summary["ground_truth"] == false);
-  CHECK(summary["metrics"]["circle"]["final"].is_null());
+  const auto summary = sonomap::harness::run_scenario(recorded).summary;
+  CHECK_FALSE(summary.ground_truth);
+  CHECK_FALSE(summary.circle.final_frame.has_value());
 
   const auto a = circle_of(simulated.out / "circle.csv", 5);
   const auto b = circle_of(recorded.out / "circle.csv", 5);
