@@ -6,8 +6,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <utility>
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -18,25 +20,34 @@ namespace {
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 double number_of(const json& v) { return v.is_null() ? NAN : v.get<double>(); }
 
+// RasterMetrics' fields as summary.json names them (one list for writing and reading): the
+// ratios, which may be undefined (null), and the counts.
+template <typename Metrics>  // eval::RasterMetrics, const or not
+auto ratio_fields(Metrics& m) {
+  using Field = std::pair<const char*, decltype(&m.coverage)>;
+  return std::array<Field, 3>{Field{"coverage", &m.coverage}, Field{"rmse", &m.rmse},
+                              Field{"rmse_off_edges", &m.rmse_off_edges}};
+}
+template <typename Metrics>
+auto count_fields(Metrics& m) {
+  using Field = std::pair<const char*, decltype(&m.cells)>;
+  return std::array<Field, 6>{Field{"edge_cells", &m.edge_cells}, Field{"ghosts", &m.ghosts},
+                              Field{"known_in_both", &m.known_in_both},
+                              Field{"truth_occupied", &m.truth_occupied},
+                              Field{"estimate_known", &m.estimate_known}, Field{"cells", &m.cells}};
+}
+
 json metrics_json(const eval::RasterMetrics& m) {
-  return json{{"coverage", number(m.coverage)}, {"rmse", number(m.rmse)},
-              {"rmse_off_edges", number(m.rmse_off_edges)}, {"edge_cells", m.edge_cells},
-              {"ghosts", m.ghosts}, {"known_in_both", m.known_in_both},
-              {"truth_occupied", m.truth_occupied}, {"estimate_known", m.estimate_known},
-              {"cells", m.cells}};
+  json j = json::object();
+  for (const auto& [key, value] : ratio_fields(m)) j[key] = number(*value);
+  for (const auto& [key, value] : count_fields(m)) j[key] = *value;
+  return j;
 }
 
 eval::RasterMetrics metrics_of(const json& j) {
   eval::RasterMetrics m;
-  m.coverage = number_of(j.at("coverage"));
-  m.rmse = number_of(j.at("rmse"));
-  m.rmse_off_edges = number_of(j.at("rmse_off_edges"));
-  j.at("edge_cells").get_to(m.edge_cells);
-  j.at("ghosts").get_to(m.ghosts);
-  j.at("known_in_both").get_to(m.known_in_both);
-  j.at("truth_occupied").get_to(m.truth_occupied);
-  j.at("estimate_known").get_to(m.estimate_known);
-  j.at("cells").get_to(m.cells);
+  for (const auto& [key, value] : ratio_fields(m)) *value = number_of(j.at(key));
+  for (const auto& [key, value] : count_fields(m)) j.at(key).get_to(*value);
   return m;
 }
 
