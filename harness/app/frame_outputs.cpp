@@ -22,7 +22,11 @@ SweepMaker::~SweepMaker() = default;
 
 void SweepMaker::write(const FrameView& frame) {
   if (!renderer_) make_renderer(frame);
-  write_sweep(renderer_->render(*frame.circle), dir_ / fmt::format("frame_{:06d}.wav", frame.index));
+  const fs::path wav = dir_ / fmt::format("frame_{:06d}.wav", frame.index);
+  const audio::SweepAudio audio = renderer_->render(*frame.circle);
+  write_sweep(audio, wav);
+  levels_.push_back({wav.filename().string(), audio.gain_db, audio.loudness.integrated_lufs,
+                     audio.loudness.true_peak_dbtp, audio.peak_limited});
 }
 
 void SweepMaker::make_renderer(const FrameView& frame) {

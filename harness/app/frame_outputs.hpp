@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace sonomap::audio {
 class SweepRenderer;
@@ -26,12 +27,14 @@ class SweepMaker {
   ~SweepMaker();
   // dir/frame_NNNNNN.wav and its event log: the circular ranging of the frame's circle.
   void write(const FrameView& frame);
+  const std::vector<SweepLevel>& levels() const { return levels_; }
 
  private:
   void make_renderer(const FrameView& frame);
   std::filesystem::path dir_, brir_dir_;
   bool quiet_;
   std::unique_ptr<audio::SweepRenderer> renderer_;
+  std::vector<SweepLevel> levels_;
 };
 
 class FrameOutputs {
@@ -42,6 +45,8 @@ class FrameOutputs {
                const RasterConfig& raster);
   // The frame's pictures and sweep, if the schedule chose it for them.
   void write(const FrameView& frame);
+  // Per sweep written: the gain applied and the loudness measured.
+  const std::vector<SweepLevel>& sweep_levels() const { return sweeps_.levels(); }
 
  private:
   void draw_pictures(const FrameView& frame) const;

@@ -112,6 +112,7 @@ RunOutcome run_scenario(const RunOptions& options) {
 
   RunSummary summary = describe_run(options, inputs, *mapper);
   results.fill_metrics(summary, inputs.settings.edf_enabled);
+  summary.sweeps = outputs.sweep_levels();
   results.finish(summary, *mapper);
   staged.commit();
   return RunOutcome{options.out, summary};

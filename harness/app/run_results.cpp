@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/app/run_results.hpp"
 
+#include "harness/app/result_files.hpp"
 #include "harness/formats/mesh_io.hpp"
 
 #include <fmt/format.h>
@@ -14,25 +15,7 @@ namespace fs = std::filesystem;
 namespace sonomap::harness {
 namespace {
 
-// A range for CSV: empty when unknown; fixed precision so reruns compare byte for byte.
-std::string csv_range(const RasterCell& cell) {
-  return cell.known() ? fmt::format("{:.6f}", cell.range) : std::string();
-}
-
 std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v) : ""; }
-
-constexpr const char* kFramesHeader =
-    "frame,time,x,y,z,heading_deg,"
-    "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
-    "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
-    "cylinder_known,edf_coverage,edf_rmse,edf_rmse_off_edges,edf_ghosts,edf_known,"
-    "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known\n";
-
-std::string pose_csv(const Eigen::Isometry3d& world_T_body) {
-  const Eigen::Vector3d p = world_T_body.translation();
-  return fmt::format("{:.6f},{:.6f},{:.6f},{:.4f}", p.x(), p.y(), p.z(),
-                     heading_of(world_T_body) * 180.0 / M_PI);
-}
 
 // coverage,rmse,rmse_off_edges,ghosts,known (ghosts empty without truth).
 std::string metrics_csv(const eval::RasterMetrics& m, bool has_truth) {
@@ -78,7 +61,7 @@ FrameRow FrameRow::of(int frame, double time, const Eigen::Isometry3d& world_T_b
 
 RunResults::RunResults(const fs::path& dir, bool write_rasters)
     : dir_(dir), frames_(dir / "frames.csv"), timings_(dir / "timings.csv") {
-  frames_ << kFramesHeader;
+  frames_ << frames_csv_header();
   if (write_rasters) {
     circle_.emplace(dir / "circle.csv");
     cylinder_.emplace(dir / "cylinder.csv");
@@ -108,17 +91,8 @@ void RunResults::add_row(const FrameRow& row) {
 
 void RunResults::add_rasters(const FrameView& f) {
   if (!circle_) return;
-  const int frame = f.index;
-  const Circle& circle = *f.circle;
-  const Cylinder& cylinder = *f.cylinder;
-  const eval::GroundTruthRasters& truth = f.evaluation->truth;
-  for (int k = 0; k < circle.size(); ++k)
-    *circle_ << frame << ',' << k << ',' << csv_range(circle.bins[k]) << ','
-             << csv_range(truth.circle.bins[k]) << '\n';
-  for (int r = 0; r < cylinder.rows; ++r)
-    for (int k = 0; k < cylinder.azimuth_bins; ++k)
-      *cylinder_ << frame << ',' << r << ',' << k << ',' << csv_range(cylinder.at(r, k)) << ','
-                 << csv_range(truth.cylinder.at(r, k)) << '\n';
+  write_circle_rows(circle_->stream(), f.index, *f.circle, f.evaluation->truth.circle);
+  write_cylinder_rows(cylinder_->stream(), f.index, *f.cylinder, f.evaluation->truth.cylinder);
 }
 
 // The columns are the stages of the first frame (every frame has them; evaluated frames more).

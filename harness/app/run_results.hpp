@@ -34,6 +34,7 @@ class ResultFile {
     out_ << value;
     return *this;
   }
+  std::ostream& stream() { return out_; }
   // Throws std::runtime_error naming the file if any write failed.
   void close();
 

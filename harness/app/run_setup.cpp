@@ -3,30 +3,17 @@
 
 #include "harness/app/cli.hpp"
 #include "harness/app/mapper_factory.hpp"
+#include "harness/app/result_files.hpp"
 #include "harness/support/errors.hpp"
 
 #include <algorithm>
 
 namespace sonomap::harness {
-namespace {
-
-std::map<std::string, std::string> parse_tags(const std::vector<std::string>& tags) {
-  std::map<std::string, std::string> out;
-  for (const std::string& t : tags) {
-    const auto eq = t.find('=');
-    if (eq == std::string::npos || eq == 0) throw InputError("--tag " + t + ": expected key=value");
-    out[t.substr(0, eq)] = t.substr(eq + 1);
-  }
-  return out;
-}
-
-}  // namespace
-
 RunInputs load_run_inputs(const RunOptions& options) {
   if (options.frames < 0) throw InputError("--frames must be positive, got " + std::to_string(options.frames));
   if (options.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(options.every));
   RunInputs inputs;
-  inputs.tags = parse_tags(options.tags);
+  inputs.tags = tags_json(options.tags).get<std::map<std::string, std::string>>();
   std::vector<std::string> scenario_overrides;
   split_overrides(options.overrides, scenario_overrides, inputs.settings);
   inputs.source = open_frame_source(options.scenario, std::move(scenario_overrides),

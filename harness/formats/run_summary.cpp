@@ -37,7 +37,7 @@ auto count_fields(Metrics& m) {
                               Field{"estimate_known", &m.estimate_known}, Field{"cells", &m.cells}};
 }
 
-json metrics_json(const eval::RasterMetrics& m) {
+json metrics_json_of(const eval::RasterMetrics& m) {
   json j = json::object();
   for (const auto& [key, value] : ratio_fields(m)) j[key] = number(*value);
   for (const auto& [key, value] : count_fields(m)) j[key] = *value;
@@ -51,9 +51,9 @@ eval::RasterMetrics metrics_of(const json& j) {
   return m;
 }
 
-json raster_summary_json(const RasterSummary& r) {
+json raster_summary_json_of(const RasterSummary& r) {
   const MeanMetrics& m = r.mean;
-  return json{{"final", r.final_frame ? metrics_json(*r.final_frame) : json(nullptr)},
+  return json{{"final", r.final_frame ? metrics_json_of(*r.final_frame) : json(nullptr)},
               {"mean", {{"coverage", number(m.coverage)}, {"rmse", number(m.rmse)},
                         {"rmse_off_edges", number(m.rmse_off_edges)}, {"ghosts", number(m.ghosts)}}}};
 }
@@ -144,11 +144,16 @@ RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples)
   return timings;
 }
 
-std::string config_hash(const RunConfig& config) {
+std::string config_hash(const json& config) {
   std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : json(config).dump()) h = (h ^ c) * 1099511628211ull;
+  for (unsigned char c : config.dump()) h = (h ^ c) * 1099511628211ull;
   return fmt::format("{:016x}", h);
 }
+
+std::string config_hash(const RunConfig& config) { return config_hash(json(config)); }
+
+json metrics_json(const eval::RasterMetrics& m) { return metrics_json_of(m); }
+json raster_summary_json(const RasterSummary& r) { return raster_summary_json_of(r); }
 
 void to_json(json& j, const RunConfig& c) {
   const EdfRasterConfig& t = c.edf.trace;
@@ -203,10 +208,14 @@ void to_json(json& j, const RunSummary& s) {
            {"config_hash", config_hash(s.config)},
            {"evaluated_frames", s.evaluated_frames},
            {"tags", json(s.tags)},
-           {"metrics", {{"circle", raster_summary_json(s.circle)},
-                        {"cylinder", raster_summary_json(s.cylinder)}}}};
-  if (s.edf_circle) j["metrics"]["edf_circle"] = raster_summary_json(*s.edf_circle);
+           {"metrics", {{"circle", raster_summary_json_of(s.circle)},
+                        {"cylinder", raster_summary_json_of(s.cylinder)}}}};
+  if (s.edf_circle) j["metrics"]["edf_circle"] = raster_summary_json_of(*s.edf_circle);
   if (s.edf) j["edf"] = edf_summary_json(*s.edf);
+  j["sweeps"] = json::array();
+  for (const SweepLevel& l : s.sweeps)
+    j["sweeps"].push_back({{"file", l.file}, {"gain_db", l.gain_db}, {"loudness_lufs", l.loudness_lufs},
+                           {"true_peak_dbtp", l.true_peak_dbtp}, {"peak_limited", l.peak_limited}});
 }
 
 void from_json(const json& j, RunSummary& s) {
@@ -229,6 +238,10 @@ void from_json(const json& j, RunSummary& s) {
   s.cylinder = raster_summary_of(m.at("cylinder"));
   if (m.contains("edf_circle")) s.edf_circle = raster_summary_of(m.at("edf_circle"));
   if (j.contains("edf")) s.edf = edf_summary_of(j.at("edf"));
+  for (const json& l : j.value("sweeps", json::array()))
+    s.sweeps.push_back({l.at("file").get<std::string>(), l.at("gain_db").get<double>(),
+                        number_of(l.at("loudness_lufs")), number_of(l.at("true_peak_dbtp")),
+                        l.at("peak_limited").get<bool>()});
 }
 
 void to_json(json& j, const StageTiming& t) {

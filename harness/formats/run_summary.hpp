@@ -65,6 +65,13 @@ struct RunConfig {
   std::vector<std::string> overrides;
 };
 
+// One sweep written: the one gain applied and the loudness measured (summary.json "sweeps").
+struct SweepLevel {
+  std::string file;
+  double gain_db = 0.0, loudness_lufs = 0.0, true_peak_dbtp = 0.0;
+  bool peak_limited = false;
+};
+
 struct RunSummary {
   int schema_version = kResultSchemaVersion;
   std::string scenario_name;
@@ -78,6 +85,7 @@ struct RunSummary {
   RasterSummary circle, cylinder;
   std::optional<RasterSummary> edf_circle;  // with the EDF comparison on
   std::optional<EdfSummary> edf;            // with the EDF comparison on
+  std::vector<SweepLevel> sweeps;
 };
 
 // timings.json: per stage, the median wall time over the frames it ran in.
@@ -88,8 +96,14 @@ struct StageTiming {
 using RunTimings = std::map<std::string, StageTiming>;
 RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples);
 
-// FNV-1a over the canonical JSON of the configuration: a short, stable hash.
+// FNV-1a over the canonical JSON of a configuration: a short, stable hash.
+std::string config_hash(const nlohmann::json& config);
 std::string config_hash(const RunConfig& config);
+
+// One frame's metrics and one raster's summary as summary.json holds them (NaN -> null), for
+// result directories written without a whole RunSummary at hand.
+nlohmann::json metrics_json(const eval::RasterMetrics& m);
+nlohmann::json raster_summary_json(const RasterSummary& r);
 
 void to_json(nlohmann::json& j, const RunConfig& c);
 void from_json(const nlohmann::json& j, RunConfig& c);
