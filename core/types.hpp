@@ -33,14 +33,12 @@ struct Frame {
   PinholeIntrinsics intrinsics;  // of `depth` (projective integrators need them)
   // The valid pixels back-projected into the camera optical frame (x right, y down, z forward).
   std::vector<Eigen::Vector3f> points_camera;
-  // Camera pose in the world as handed to the mapper (localisation estimate) ...
+  // Camera pose in the world as handed to the mapper (the localisation estimate: a real
+  // mapper never knows the true pose, which stays with the evaluator) ...
   Eigen::Isometry3d world_T_camera = Eigen::Isometry3d::Identity();
   // ... and the body (listener) pose that goes with it; rasters are centred on the body
   // position with the body heading.
   Eigen::Isometry3d world_T_body = Eigen::Isometry3d::Identity();
-  // The true poses (simulation only; ground truth always uses these).
-  Eigen::Isometry3d world_T_camera_true = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d world_T_body_true = Eigen::Isometry3d::Identity();
 };
 
 // Where a raster is centred: a position and a heading (yaw of the body x axis, radians),

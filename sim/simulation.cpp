@@ -129,13 +129,11 @@ Frame Simulation::render(int frame) {
   out.height = scenario_.camera.height;
   const CameraSpec& c = scenario_.camera;
   out.intrinsics = PinholeIntrinsics{c.fx, c.fy, c.cx, c.cy};
-  out.world_T_body_true = true_body_pose(t);
-  out.world_T_camera_true = out.world_T_body_true * scenario_.camera.body_T_camera;
   out.world_T_body = localisation_->estimated_body_pose(scenario_.body, frame, t);
   out.world_T_camera = out.world_T_body * scenario_.camera.body_T_camera;
 
   world_->set_time(t);
-  const DepthImage truth = camera_->trace(*world_, out.world_T_camera_true);
+  const DepthImage truth = camera_->trace(*world_, true_camera_pose(t));
   const NoiseKey key{scenario_.seed, kSensorId, static_cast<std::uint64_t>(frame)};
   const double focal = scenario_.camera.fx;
   DepthImage measured = camera_->clip_to_range(apply_noise(truth, scenario_.noise, focal, key));

@@ -10,7 +10,7 @@
 #include "core/stopwatch.hpp"
 #include "core/tsdf.hpp"
 #include "harness/app/mapper_factory.hpp"
-#include "harness/app/run.hpp"
+#include "core/rasterise_map.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"

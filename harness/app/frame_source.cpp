@@ -25,7 +25,10 @@ class SimulatedSource final : public FrameSource {
   }
   std::string name() const override { return scenario_.name; }
   int frame_count() const override { return simulation_->frame_count(); }
-  Frame frame(int i) override { return simulation_->render(i); }
+  SourceFrame frame(int i) override {
+    const Eigen::Isometry3d world_T_body_true = simulation_->true_body_pose(simulation_->time_of(i));
+    return {simulation_->render(i), world_T_body_true};
+  }
   double ground_z() const override { return scenario_.ground_z; }
   std::uint64_t seed() const override { return scenario_.seed; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
@@ -47,7 +50,12 @@ class RecordedSource final : public FrameSource {
   }
   std::string name() const override { return sequence_->name(); }
   int frame_count() const override { return count_; }
-  Frame frame(int i) override { return sequence_->frame(i); }
+  // The recorded pose is all there is: it stands for the truth as well.
+  SourceFrame frame(int i) override {
+    Frame frame = sequence_->frame(i);
+    const Eigen::Isometry3d world_T_body = frame.world_T_body;
+    return {std::move(frame), world_T_body};
+  }
   double ground_z() const override { return sequence_->ground_z(); }
   std::uint64_t seed() const override { return 0; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }

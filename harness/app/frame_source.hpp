@@ -15,12 +15,19 @@
 
 namespace sonomap::harness {
 
+// A frame as the mapper gets it (depth, points, the ESTIMATED pose) and the true body pose,
+// which stays with the evaluator.
+struct SourceFrame {
+  Frame frame;
+  Eigen::Isometry3d world_T_body_true = Eigen::Isometry3d::Identity();
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
   virtual std::string name() const = 0;
   virtual int frame_count() const = 0;
-  virtual Frame frame(int i) = 0;
+  virtual SourceFrame frame(int i) = 0;
   virtual double ground_z() const = 0;
   virtual std::uint64_t seed() const = 0;
   // World triangles at time t, or nullopt when there is no ground truth (recorded data).

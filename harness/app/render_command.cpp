@@ -69,7 +69,8 @@ void render_sequence(const fs::path& scenario_file, const std::vector<std::strin
   Progress progress("render", frames, quiet);
   for (int i = 0; i < frames; ++i) {
     throw_if_interrupted();
-    writer.add(simulation->render(i));
+    const Frame frame = simulation->render(i);
+    writer.add(frame, simulation->true_camera_pose(frame.time));
     progress.update(i + 1);
   }
   writer.finish();

@@ -13,32 +13,8 @@ using nlohmann::json;
 
 namespace sonomap::harness {
 
-namespace {
-json number_or_null(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-}  // namespace
-
-json metrics_json(const eval::RasterMetrics& m) {
-  return json{{"coverage", number_or_null(m.coverage)}, {"rmse", number_or_null(m.rmse)},
-              {"rmse_off_edges", number_or_null(m.rmse_off_edges)}, {"edge_cells", m.edge_cells},
-              {"ghosts", m.ghosts},          {"known_in_both", m.known_in_both},
-              {"truth_occupied", m.truth_occupied}, {"estimate_known", m.estimate_known},
-              {"cells", m.cells}};
-}
-
 json metrics_summary(const std::vector<eval::RasterMetrics>& frames) {
-  double cov = 0, rmse = 0, rmse_off = 0, ghosts = 0;
-  int n_cov = 0, n_rmse = 0, n_off = 0;
-  for (const auto& m : frames) {
-    if (std::isfinite(m.coverage)) cov += m.coverage, ++n_cov;
-    if (std::isfinite(m.rmse)) rmse += m.rmse, ++n_rmse;
-    if (std::isfinite(m.rmse_off_edges)) rmse_off += m.rmse_off_edges, ++n_off;
-    ghosts += m.ghosts;
-  }
-  json mean{{"coverage", n_cov ? json(cov / n_cov) : json(nullptr)},
-            {"rmse", n_rmse ? json(rmse / n_rmse) : json(nullptr)},
-            {"rmse_off_edges", n_off ? json(rmse_off / n_off) : json(nullptr)},
-            {"ghosts", frames.empty() ? json(nullptr) : json(ghosts / frames.size())}};
-  return json{{"final", frames.empty() ? json(nullptr) : metrics_json(frames.back())}, {"mean", mean}};
+  return raster_summary_json(RasterSummary::of(frames));
 }
 
 std::string csv_range(const RasterCell& cell) {
@@ -79,12 +55,6 @@ json tags_json(const std::vector<std::string>& tags) {
     out[t.substr(0, eq)] = t.substr(eq + 1);
   }
   return out;
-}
-
-std::string config_hash(const json& config) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : config.dump()) h = (h ^ c) * 1099511628211ull;
-  return fmt::format("{:016x}", h);
 }
 
 }  // namespace sonomap::harness

@@ -5,6 +5,7 @@
 
 #include "core/raster.hpp"
 #include "eval/metrics.hpp"
+#include "harness/formats/run_summary.hpp"  // metrics_json, config_hash
 
 #include <Eigen/Geometry>
 
@@ -15,9 +16,6 @@
 #include <vector>
 
 namespace sonomap::harness {
-
-// One raster's metrics of one frame, as summary.json holds them (NaN -> null).
-nlohmann::json metrics_json(const eval::RasterMetrics& m);
 
 // summary.json's {"final": last frame's metrics, "mean": coverage, rmse, rmse_off_edges and
 // ghosts averaged over the frames where each is defined}.
@@ -37,7 +35,5 @@ std::string pose_csv(const Eigen::Isometry3d& world_T_body);
 // "key=value" labels as summary.json's "tags" object; InputError naming a malformed one.
 nlohmann::json tags_json(const std::vector<std::string>& tags);
 
-// FNV-1a over the canonical JSON of a configuration: a short, stable config hash.
-std::string config_hash(const nlohmann::json& config);
 
 }  // namespace sonomap::harness

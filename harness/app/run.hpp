@@ -1,26 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One run: sensor -> mapper -> rasters -> ground truth -> metrics (-> pictures, sweeps), written
-// as one result directory. The directory appears whole (staged, renamed when complete).
-//
-// Result directory (documented in README.md, "Result directory"):
-//   summary.json   scenario, seed, code version, mapper and raster config, config hash,
-//                  per-raster final and mean metrics (byte-identical across reruns and threads)
-//   frames.csv     one row per evaluated frame: pose and per-raster metrics
-//   timings.csv    one row per frame: wall time of each stage in ms (the only file that varies)
-//   circle.csv     frame,bin,estimate,truth (unknown = empty field)
-//   cylinder.csv   frame,row,bin,estimate,truth
-//   edf.csv        the final frame's EDF comparison per bin (run keys edf.*; core/edf_raster.hpp)
-//   pictures/      frame_NNNNNN_circle.png, frame_NNNNNN_cylinder.png
-//   sweeps/        frame_NNNNNN.wav, frame_NNNNNN.events.csv (circular ranging of the map's
-//                  circle), room.json (the room the BRIRs were synthesised for)
-//   map.ply        the mapper's final surface mesh (mappers that have one)
+// One run: sensor -> mapper -> rasters -> evaluation (ground truth, metrics, EDF) -> pictures,
+// sweeps, written as one result directory (docs/results.md). The directory appears whole
+// (staged, renamed when complete). The steps live in their own units:
+//   run_setup      load the scenario and run keys, build the mapper, plan the frames
+//   core/rasterise_map, eval/evaluate_frame   the per-frame computation
+//   run_results    frames.csv, circle.csv, cylinder.csv, edf.csv, timings, summary.json
+//   frame_outputs  pictures/ and sweeps/ for the chosen frames
 #pragma once
 
-#include "core/mapper.hpp"
-#include "core/rasteriser.hpp"
 #include "harness/app/cli.hpp"
-
-#include <nlohmann/json.hpp>
+#include "harness/formats/run_summary.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -56,16 +45,10 @@ struct RunOptions {
 
 struct RunOutcome {
   std::filesystem::path dir;
-  nlohmann::json summary;
+  RunSummary summary;  // as written to dir/summary.json
 };
 
 RunOutcome run_scenario(const RunOptions& options);
-
-// The map's circle and cylinder around `origin`, as a run builds them: the mapper's surface
-// samples within the raster's max_range, added to the rasteriser reset on `origin`. `surface`
-// is reused scratch and holds those samples afterwards. (`bench map` times this same call.)
-void rasterise_map(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& rasteriser,
-                   std::vector<Eigen::Vector3f>& surface);
 
 // A one-screen summary of a run, for the terminal.
 std::string summary_screen(const RunOutcome& outcome);

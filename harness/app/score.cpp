@@ -6,6 +6,7 @@
 #include "harness/app/result_files.hpp"
 #include "harness/app/run_settings.hpp"
 
+#include "eval/evaluate_frame.hpp"
 #include "eval/ground_truth.hpp"
 #include "eval/metrics.hpp"
 #include "harness/formats/circle_io.hpp"
@@ -195,17 +196,23 @@ Scores score_frames(const Estimates& estimates, FrameSource& source, const RunSe
   Progress progress("score " + source.name(), static_cast<long>(estimates.circle.frames.size()), o.quiet);
   for (const auto& [i, cells] : estimates.circle.frames) {
     throw_if_interrupted();
-    const Frame frame = source.frame(i);
-    const RasterOrigin origin = raster_origin(frame.world_T_body_true, source.ground_z());
-    const eval::GroundTruthRasters truth = eval::ground_truth_rasters(*source.truth(frame.time), origin, settings.raster);
+    const SourceFrame sensed = source.frame(i);
+    const Frame& frame = sensed.frame;
+    const RasterOrigin origin = raster_origin(sensed.world_T_body_true, source.ground_z());
     Circle circle(settings.raster.azimuth_bins);
     circle.bins = cells;
     place_points(circle, origin);
     Cylinder cylinder = make_cylinder(settings.raster);
     if (with_cylinder) cylinder.cells = estimates.cylinder.frames.at(i);
-    scores.circle.push_back(eval::compare(circle, truth.circle, settings.metrics));
-    if (with_cylinder) scores.cylinder.push_back(eval::compare(cylinder, truth.cylinder, settings.metrics));
-    frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ',' << pose_csv(frame.world_T_body_true)
+    // The evaluation `run` uses, without the EDF comparison (no map to trace in).
+    const auto triangles = source.truth(frame.time);
+    const eval::FrameEvaluation evaluation = eval::evaluate_frame(
+        circle, cylinder, eval::FrameTruth{&*triangles, origin}, nullptr, origin,
+        {settings.raster, settings.metrics, settings.edf});
+    const eval::GroundTruthRasters& truth = evaluation.truth;
+    scores.circle.push_back(evaluation.circle);
+    if (with_cylinder) scores.cylinder.push_back(evaluation.cylinder);
+    frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ',' << pose_csv(sensed.world_T_body_true)
                << ',' << frame_metrics_csv(scores.circle.back(), true) << ','
                << frame_metrics_csv(with_cylinder ? scores.cylinder.back() : eval::RasterMetrics{}, with_cylinder)
                << ",,,,,,,,\n";
@@ -255,7 +262,8 @@ json score_rasters(const ScoreOptions& o) {
   const Scores scores = score_frames(estimates, *source, settings, o, dir);
 
   const json config = score_config(o, settings, frame_count, source->seed());
-  const json summary{{"scenario", {{"name", source->name()}, {"file", o.scenario.string()}}},
+  const json summary{{"schema_version", kResultSchemaVersion},
+                     {"scenario", {{"name", source->name()}, {"file", o.scenario.string()}}},
                      {"seed", source->seed()},
                      {"code_version", code_version()},
                      {"ground_truth", true},

@@ -33,9 +33,7 @@ Frame frame_from_record(int index, const DepthRecord& record, double time_zero,
     }
   }
   frame.world_T_camera = record.world_T_camera;
-  frame.world_T_camera_true = record.world_T_camera;
   frame.world_T_body = record.world_T_camera * camera.body_T_camera.inverse();
-  frame.world_T_body_true = frame.world_T_body;
   return frame;
 }
 

@@ -250,7 +250,7 @@ TumWriter::TumWriter(fs::path dir, CameraFile camera)
   groundtruth_ = "# ground truth trajectory\n" + origin + "# timestamp tx ty tz qx qy qz qw\n";
 }
 
-void TumWriter::add(const Frame& frame) {
+void TumWriter::add(const Frame& frame, const Eigen::Isometry3d& world_T_camera_true) {
   DepthImage16 image;
   image.width = frame.width;
   image.height = frame.height;
@@ -263,7 +263,7 @@ void TumWriter::add(const Frame& frame) {
   const std::string name = "depth/" + stamp + ".png";
   write_png16(dir_ / name, image);
   depth_list_ += stamp + " " + name + "\n";
-  groundtruth_ += pose_line(frame.time, frame.world_T_camera_true);
+  groundtruth_ += pose_line(frame.time, world_T_camera_true);
 }
 
 void TumWriter::finish() {

@@ -35,8 +35,9 @@ DepthImage16 read_png16(const std::filesystem::path& file);
 class TumWriter {
  public:
   TumWriter(std::filesystem::path dir, CameraFile camera);
-  // Depth in metres to PNG units (rounded); a depth the 16 bits cannot hold becomes 0.
-  void add(const Frame& frame);
+  // Depth in metres to PNG units (rounded); a depth the 16 bits cannot hold becomes 0. The
+  // true camera pose goes to groundtruth.txt.
+  void add(const Frame& frame, const Eigen::Isometry3d& world_T_camera_true);
   void finish();
 
  private:
@@ -71,8 +72,8 @@ TumSequence read_tum_sequence(const std::filesystem::path& dir,
 DepthRecord read_tum_record(const TumSequence& sequence, std::size_t i);
 
 // Frame i as the mapper sees it: z-depth in metres (0 outside [min_range, max_range]), the
-// back-projected points, and the poses (the recorded pose is both "given" and "true"; the
-// body pose is camera pose * camera_T_body). time = timestamp - first frame's timestamp.
+// back-projected points, and the recorded pose as the given one (a run takes it as the true
+// pose too; the body pose is camera pose * camera_T_body). time = timestamp - first frame's timestamp.
 Frame load_tum_frame(const TumSequence& sequence, std::size_t i);
 
 }  // namespace sonomap::harness

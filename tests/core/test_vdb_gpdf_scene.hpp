@@ -88,8 +88,8 @@ inline Frame render(const Scene& scene, const Eigen::Isometry3d& world_T_camera,
   f.width = width;
   f.height = height;
   f.depth.assign(static_cast<size_t>(width) * height, 0.0f);
-  f.world_T_camera = f.world_T_camera_true = world_T_camera;
-  f.world_T_body = f.world_T_body_true = world_T_camera;
+  f.world_T_camera = world_T_camera;
+  f.world_T_body = world_T_camera;
   const double fx = 0.82 * width, fy = fx, cx = (width - 1) / 2.0, cy = (height - 1) / 2.0;
   f.intrinsics = PinholeIntrinsics{fx, fy, cx, cy};
   for (int v = 0; v < height; ++v)

@@ -8,6 +8,7 @@
 #include "eval/metrics.hpp"
 #include "sim/primitives.hpp"
 #include "sim/simulation.hpp"
+#include "sim/trajectory.hpp"
 #include "sim/world_geometry.hpp"
 
 #include <catch2/catch.hpp>
@@ -71,7 +72,7 @@ Evaluation evaluate(Mapper& mapper, const sim::Scenario& s, const Frame& frame) 
   rasteriser.reset(origin);
   rasteriser.add(surface);
   const auto truth = eval::ground_truth_rasters(sim::world_triangles(s, frame.time),
-                                                   raster_origin(frame.world_T_body_true), config);
+                                                   raster_origin(sim::pose_at(s.body, frame.time)), config);
   eval::MetricsConfig metrics;
   metrics.ghost_tolerance = 0.10;
   return {eval::compare(rasteriser.circle(), truth.circle, metrics),

@@ -61,9 +61,9 @@ TEST_CASE("the depth-only circle in the room covers about one camera view, well 
   o.picture_frames = {-1};
   o.sweep_frames = {-1};
   o.quiet = true;
-  const json summary = sonomap::harness::run_scenario(o).summary;
-  const double circle = summary["metrics"]["circle"]["mean"]["coverage"];
-  const double cylinder = summary["metrics"]["cylinder"]["mean"]["coverage"];
+  const auto summary = sonomap::harness::run_scenario(o).summary;
+  const double circle = summary.circle.mean.coverage;
+  const double cylinder = summary.cylinder.mean.coverage;
   CHECK(circle > 0.08);
   CHECK(circle < 0.20);
   CHECK(cylinder < 0.20);
@@ -129,10 +129,12 @@ TEST_CASE("regression: VDB-GPDF on the smoke scene keeps its coverage, accuracy 
   ScratchDir scratch("run-regression");
   auto o = sonomap::test::smoke_run(scratch.path() / "out", "vdb_gpdf", 60);
   o.every = 6;
-  const json m = sonomap::harness::run_scenario(o).summary["metrics"];
-  CHECK(m["circle"]["final"]["coverage"].get<double>() >= 0.344);
-  CHECK(m["circle"]["mean"]["coverage"].get<double>() >= 0.259);
-  CHECK(m["cylinder"]["final"]["coverage"].get<double>() >= 0.327);
-  CHECK(m["circle"]["mean"]["rmse_off_edges"].get<double>() <= 0.40);
-  CHECK(m["circle"]["final"]["ghosts"].get<int>() <= 4);
+  const auto m = sonomap::harness::run_scenario(o).summary;
+  REQUIRE(m.circle.final_frame);
+  REQUIRE(m.cylinder.final_frame);
+  CHECK(m.circle.final_frame->coverage >= 0.344);
+  CHECK(m.circle.mean.coverage >= 0.259);
+  CHECK(m.cylinder.final_frame->coverage >= 0.327);
+  CHECK(m.circle.mean.rmse_off_edges <= 0.40);
+  CHECK(m.circle.final_frame->ghosts <= 4);
 }

@@ -35,9 +35,9 @@ TEST_CASE("a rendered TUM sequence gives the simulator's circle within the depth
   recorded.scenario = tum;
   recorded.out = scratch.path() / "recorded";
   recorded.overrides.clear();
-  const nlohmann::json summary = sonomap::harness::run_scenario(recorded).summary;
-  CHECK(summary["ground_truth"] == false);
-  CHECK(summary["metrics"]["circle"]["final"].is_null());
+  const auto summary = sonomap::harness::run_scenario(recorded).summary;
+  CHECK_FALSE(summary.ground_truth);
+  CHECK_FALSE(summary.circle.final_frame.has_value());
 
   // Rounding z to the PNG unit moves a point by at most half a unit (0.1 mm) of z, so by
   // 0.1 mm x |ray| / z along its ray: at most 1.255 x at this camera's image corners

@@ -76,7 +76,7 @@ TEST_CASE("points of a slanted wall lie on the wall in the world", "[sim][camera
   const Eigen::Vector3d normal = pose.linear().col(2);
   REQUIRE(f.points_camera.size() == 160u * 120u);
   for (const Eigen::Vector3f& p : f.points_camera) {
-    const Eigen::Vector3d world = f.world_T_camera_true * p.cast<double>();
+    const Eigen::Vector3d world = sim.true_camera_pose(f.time) * p.cast<double>();
     CHECK(std::abs(normal.dot(world - pose.translation())) < 1e-5 * 4.0);
   }
   // The centre ray (optical axis, along world +x) meets the plane at x = 3 exactly.
@@ -169,10 +169,11 @@ TEST_CASE("frames carry the time step and the true poses", "[sim][camera]") {
   CHECK(sim.frame_count() == 10);
   const Frame f = sim.render(4);
   CHECK(f.time == Approx(0.2));
-  CHECK(f.world_T_body_true.translation().x() == Approx(0.2));
+  const Eigen::Isometry3d world_T_body_true = sim.true_body_pose(f.time);
+  CHECK(world_T_body_true.translation().x() == Approx(0.2));
   // No localisation error configured: the given pose is the true pose.
-  CHECK(f.world_T_body.isApprox(f.world_T_body_true));
-  CHECK(f.world_T_camera.isApprox(f.world_T_body_true * s.camera.body_T_camera));
+  CHECK(f.world_T_body.isApprox(world_T_body_true));
+  CHECK(f.world_T_camera.isApprox(world_T_body_true * s.camera.body_T_camera));
   // Walking 0.2 m towards the wall at x = 2 leaves 1.8 m.
   CHECK(depth_at(f, 320, 240) == Approx(1.8).epsilon(1e-5));
 }

@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A result directory's summary.json and timings.json as types (docs/results.md has the
+// schema). Written and read in this one place: `run` writes them, `report` (and anything
+// else) reads them back through the same structs, so a renamed field cannot break a reader
+// silently. Undefined numbers (NaN) are JSON null.
+#pragma once
+
+#include "core/edf_raster.hpp"
+#include "core/raster.hpp"
+#include "eval/metrics.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sonomap::harness {
+
+// Bumped whenever a field is renamed, removed or changes meaning (adding one is compatible).
+inline constexpr int kResultSchemaVersion = 1;
+
+// The means over the evaluated frames where each metric is defined (NaN: none).
+struct MeanMetrics {
+  double coverage = NAN, rmse = NAN, rmse_off_edges = NAN, ghosts = NAN;
+};
+
+// One raster's metrics: the final evaluated frame's (none without truth) and the means.
+struct RasterSummary {
+  std::optional<eval::RasterMetrics> final_frame;
+  MeanMetrics mean;
+  static RasterSummary of(const std::vector<eval::RasterMetrics>& frames);
+};
+
+// The EDF comparison's bearing slip over the frames it ran on.
+struct EdfSummary {
+  std::size_t frames = 0;
+  std::optional<SlipStats> final_slip;
+  double mean_median_deg = NAN, mean_p90_deg = NAN;  // over frames with an observed bin
+  static EdfSummary of(const std::vector<SlipStats>& frames);
+};
+
+// The EDF comparison's settings (run keys edf.*).
+struct EdfSettings {
+  bool enabled = true;
+  int every = 5;
+  int trace_rows = 4;
+  EdfRasterConfig trace;
+};
+
+// Everything that decides a run's numbers; config_hash is taken over its JSON.
+struct RunConfig {
+  std::string mapper;
+  std::map<std::string, std::string> mapper_config;  // as the mapper reports it (text)
+  RasterConfig raster;
+  eval::MetricsConfig metrics;
+  EdfSettings edf;
+  int frames = 0;
+  int every = 1;
+  std::uint64_t seed = 0;
+  std::vector<std::string> overrides;
+};
+
+// One sweep written: the one gain applied and the loudness measured (summary.json "sweeps").
+struct SweepLevel {
+  std::string file;
+  double gain_db = 0.0, loudness_lufs = 0.0, true_peak_dbtp = 0.0;
+  bool peak_limited = false;
+};
+
+struct RunSummary {
+  int schema_version = kResultSchemaVersion;
+  std::string scenario_name;
+  std::string scenario_file;
+  std::uint64_t seed = 0;
+  std::string code_version;
+  bool ground_truth = false;
+  RunConfig config;
+  int evaluated_frames = 0;
+  std::map<std::string, std::string> tags;
+  RasterSummary circle, cylinder;
+  std::optional<RasterSummary> edf_circle;  // with the EDF comparison on
+  std::optional<EdfSummary> edf;            // with the EDF comparison on
+  std::vector<SweepLevel> sweeps;
+};
+
+// timings.json: per stage, the median wall time over the frames it ran in.
+struct StageTiming {
+  double median_ms = 0.0;
+  std::size_t samples = 0;
+};
+using RunTimings = std::map<std::string, StageTiming>;
+RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples);
+
+// FNV-1a over the canonical JSON of a configuration: a short, stable hash.
+std::string config_hash(const nlohmann::json& config);
+std::string config_hash(const RunConfig& config);
+
+// One frame's metrics and one raster's summary as summary.json holds them (NaN -> null), for
+// result directories written without a whole RunSummary at hand.
+nlohmann::json metrics_json(const eval::RasterMetrics& m);
+nlohmann::json raster_summary_json(const RasterSummary& r);
+
+void to_json(nlohmann::json& j, const RunConfig& c);
+void from_json(const nlohmann::json& j, RunConfig& c);
+void to_json(nlohmann::json& j, const RunSummary& s);
+void from_json(const nlohmann::json& j, RunSummary& s);
+void to_json(nlohmann::json& j, const StageTiming& t);
+void from_json(const nlohmann::json& j, StageTiming& t);
+
+// Reads DIR/summary.json. Throws InputError naming the file when it is missing, malformed,
+// or of another schema version.
+RunSummary read_run_summary(const std::filesystem::path& dir);
+// Reads DIR/timings.json; empty when the file does not exist. Throws InputError if malformed.
+RunTimings read_run_timings(const std::filesystem::path& dir);
+
+}  // namespace sonomap::harness
