@@ -31,7 +31,7 @@ void write_smoke_bag(const fs::path& file, const sim::Scenario& scenario) {
   for (int i = 0; i < simulation.frame_count(); ++i) {
     const Frame frame = simulation.render(i);
     bag.depth("/camera/depth/image", kStart + frame.time, "camera", frame.width, frame.height, frame.depth);
-    bag.transform("/vicon/body", kStart + frame.time, "world", "body", frame.world_T_body_true);
+    bag.transform("/vicon/body", kStart + frame.time, "world", "body", simulation.true_body_pose(frame.time));
   }
   bag.close();
 }

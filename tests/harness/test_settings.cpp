@@ -7,6 +7,7 @@
 #include "test_scenario_files.hpp"
 
 #include "harness/app/cli.hpp"
+#include "harness/formats/run_summary.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/formats/tum_io.hpp"
 
@@ -218,7 +219,8 @@ TEST_CASE("set mapper.nope: the run lists the mapper's fields, and summary.json 
     o.overrides.push_back("mapper.max_range=4.25");
     o.overrides.push_back("edf.enabled=false");
     o.write_rasters = false;
-    const nlohmann::json config = sonomap::harness::run_scenario(o).summary["config"]["mapper_config"];
+    const nlohmann::json summary = sonomap::harness::run_scenario(o).summary;
+    const nlohmann::json config = summary["config"]["mapper_config"];
     for (const std::string& field : fields) {
       INFO(mapper << ": " << field);
       CHECK(config.contains(field));
