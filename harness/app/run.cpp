@@ -67,8 +67,7 @@ void write_edf_csv(const fs::path& file, int frame, const Circle& map_circle, co
         << csv_number(edf.traced.bins[k].point.z() - ground_z) << ',' << csv_range(truth.bins[k])
         << ',' << trace_end_name(b.end) << '\n';
   }
-  out.close();
-  if (out.fail()) throw std::runtime_error("writing " + file.string() + " failed");
+  close_checked(out, file);
 }
 
 bool chosen(const std::vector<int>& list, int frame, int last_evaluated) {
@@ -114,7 +113,7 @@ class SweepMaker {
                              {"listener_heading_deg", room.listener_heading_deg},
                              {"rt60", room.rt60}, {"max_order", room.max_order},
                              {"hrir", setup.room.hrir_file.string()}};
-        std::ofstream(dir / "room.json") << room_json.dump(2) << '\n';
+        write_text_file(dir / "room.json", room_json.dump(2) + "\n");
       }
       renderer_ = std::make_unique<audio::SweepRenderer>(brirs, setup.sweep);
     }
@@ -164,7 +163,9 @@ RunOutcome run_scenario(const RunOptions& options) {
       if (key == "global_voxel" || key == "voxel") settings.metrics.ghost_tolerance = 2.0 * std::stod(value);
   }
 
-  StagedDirectory staged(options.out);
+  std::vector<fs::path> inputs = source->inputs();
+  inputs.push_back(options.brir_dir.empty() ? default_hrir_file() : options.brir_dir);
+  StagedDirectory staged(options.out, "run", inputs);
   const fs::path dir = staged.path();
   const auto wants = [](const std::vector<int>& frames) {
     return frames.empty() || std::any_of(frames.begin(), frames.end(), [](int f) { return f >= 0; });
@@ -371,25 +372,18 @@ RunOutcome run_scenario(const RunOptions& options) {
     timings[name] = {{"median_ms", samples[samples.size() / 2]}, {"samples", samples.size()}};
   }
 
-  for (std::ofstream* f : {&frames_csv, &timings_csv, &circle_csv, &cylinder_csv})
-    if (f->is_open()) {
-      f->close();
-      if (f->fail()) throw std::runtime_error("writing the result files in " + dir.string() + " failed");
-    }
+  close_checked(frames_csv, dir / "frames.csv");
+  close_checked(timings_csv, dir / "timings.csv");
+  close_checked(circle_csv, dir / "circle.csv");
+  close_checked(cylinder_csv, dir / "cylinder.csv");
   {
     std::vector<Eigen::Vector3f> vertices;
     std::vector<Eigen::Vector3i> triangles;
     mapper->surface_mesh(vertices, triangles);
     if (!triangles.empty()) save_mesh_ply(dir / "map.ply", vertices, triangles);
   }
-  {
-    std::ofstream out(dir / "summary.json");
-    out << summary.dump(2) << '\n';
-  }
-  {
-    std::ofstream out(dir / "timings.json");
-    out << timings.dump(2) << '\n';
-  }
+  write_text_file(dir / "summary.json", summary.dump(2) + "\n");
+  write_text_file(dir / "timings.json", timings.dump(2) + "\n");
   staged.commit();
   return RunOutcome{options.out, summary};
 }
@@ -435,7 +429,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Scenario YAML file, a recorded TUM RGB-D directory (depth.txt, groundtruth.txt,\n"
                   "depth/*.png, camera.yaml), or a sequence file (sequence.yaml: a folder of depth\n"
                   "PNGs or a ROS1 bag; docs/real-data.md). Recordings: no ground truth, no metrics")->required();
-  cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
+  cmd->add_option("--out", options->out,
+                  "Result directory (written atomically): new, empty, or an earlier sonomap result")
+      ->required();
   cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--every", options->every,

@@ -466,7 +466,7 @@ void write_brir_sofa(const fs::path& file, double sample_rate, double distance_m
 
 void write_brir_directory(const fs::path& directory, const audio::BrirSet& set,
                           const SofaMetadata& meta) {
-  StagedDirectory staged(directory, true);
+  StagedDirectory staged(directory, "brir");
   const size_t na = set.azimuth_count();
   for (size_t d = 0; d < set.distance_count(); ++d) {
     std::vector<audio::BinauralIr> irs;

@@ -299,9 +299,14 @@ void add_report_command(CLI::App& app, const GlobalOptions& global) {
   CLI::App* cmd = app.add_subcommand(
       "report", "Roll up the finished runs under DIR/runs into rollup.csv, rollup_stats.csv, "
                 "pairs.csv, plots and report.md; exit status 1 when a gate fails");
-  cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (or holding runs/)")->required();
+  cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (also with --emit-jobs)")
+      ->required();
   cmd->add_option("--junit", *junit, "Also write JUnit XML: one test case per gate and claim");
   cmd->callback([dir, junit, &global] {
+    // It writes its roll-ups and plots/ there: only into a folder sonomap made.
+    if (!is_sonomap_result(*dir))
+      throw InputError(dir->string() + " is not a sonomap result (no " + kResultMarker +
+                       "); report writes only into a folder `sonomap compare` made");
     if (build_report(*dir, global.quiet, *junit).failed_gates > 0) throw CLI::RuntimeError(kExitFailure);
   });
 }
