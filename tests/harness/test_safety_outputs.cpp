@@ -9,15 +9,11 @@
 #include <sys/stat.h>
 
 namespace fs = std::filesystem;
-using sonomap::test::run_sonomap;
-using sonomap::test::ScratchDir;
-using sonomap::test::short_run;
-using sonomap::test::shipped;
-using sonomap::test::text_of;
+using namespace sonomap::test;
 
 namespace {
 
-const fs::path kSmoke = shipped("scenes/smoke.yaml");
+const fs::path kSmoke = smoke_scene();
 
 // A circle CSV as `sonify` reads it: every bin 2 m away.
 std::string circle_csv() {
@@ -46,7 +42,7 @@ TEST_CASE("run --out a folder holding a user's file exits 2 and the file is stil
   CHECK(result.output.find("exists and is not a sonomap result; choose another --out") !=
         std::string::npos);
   CHECK(text_of(notes) == "my thesis notes\n");
-  CHECK(sonomap::test::partial_entries(scratch.path()).empty());
+  CHECK(partial_entries(scratch.path()).empty());
 }
 
 TEST_CASE("run --out an existing file exits 2 and the file is unchanged", "[safety]") {
@@ -91,7 +87,7 @@ TEST_CASE("run --out equal to or inside the input sequence exits 2 and the seque
   const fs::path seq = scratch.path() / "seq";
   std::vector<std::string> render{"--quiet", "render", kSmoke.string(), "--out", seq.string(),
                                   "--frames", "2"};
-  for (const std::string& o : sonomap::test::small_camera()) render.insert(render.end(), {"--set", o});
+  for (const std::string& o : small_camera()) render.insert(render.end(), {"--set", o});
   REQUIRE(run_sonomap(render).status == 0);
   const auto before = snapshot(seq);
   for (const fs::path& out : {seq, seq / "result", seq / "depth"}) {
@@ -177,6 +173,6 @@ TEST_CASE("a rerun into a previous result replaces it whole", "[safety]") {
   REQUIRE(result.status == 0);
   const std::string summary = text_of(out / "summary.json");
   CHECK(summary.find("\"frames\": 5") != std::string::npos);
-  CHECK(sonomap::test::partial_entries(scratch.path()).empty());
+  CHECK(partial_entries(scratch.path()).empty());
   CHECK(std::distance(fs::directory_iterator(scratch.path()), fs::directory_iterator()) == 1);
 }

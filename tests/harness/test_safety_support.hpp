@@ -15,6 +15,8 @@
 
 namespace sonomap::test {
 
+inline std::filesystem::path smoke_scene() { return shipped("scenes/smoke.yaml"); }
+
 // `sonomap run` of a few frames of the smoke scene with the small camera, nothing drawn.
 inline std::vector<std::string> short_run(const std::filesystem::path& scenario,
                                           const std::filesystem::path& out, int frames = 3) {

@@ -12,15 +12,11 @@
 #include <thread>
 
 namespace fs = std::filesystem;
-using sonomap::test::partial_entries;
-using sonomap::test::ScratchDir;
-using sonomap::test::short_run;
-using sonomap::test::shipped;
-using sonomap::test::text_of;
+using namespace sonomap::test;
 
 namespace {
 
-const fs::path kSmoke = shipped("scenes/smoke.yaml");
+const fs::path kSmoke = smoke_scene();
 
 // A 256 KiB tmpfs at `dir` for the life of the object (mounted() false where not allowed).
 class SmallDisk {
@@ -57,7 +53,7 @@ TEST_CASE("a run on a full file system exits 1 with the reason and publishes not
     return;
   }
   // 12 frames of rasters (cylinder.csv: 12 x 360 x 19 rows) do not fit in 256 KiB.
-  const auto result = sonomap::test::run_sonomap(short_run(kSmoke, disk / "out", 12));
+  const auto result = run_sonomap(short_run(kSmoke, disk / "out", 12));
   INFO(result.output);
   CHECK(result.status == 1);
   CHECK(result.output.find("No space left on device") != std::string::npos);
@@ -68,8 +64,8 @@ TEST_CASE("a run whose writes fail (file-size limit, EFBIG) exits 1 and publishe
           "[safety]") {
   ScratchDir scratch("safety-fsize");
   const fs::path out = scratch.path() / "out", log = scratch.path().string() + ".log";
-  const pid_t pid = sonomap::test::start_sonomap(short_run(kSmoke, out, 12), log, 64 * 1024);
-  const int status = sonomap::test::wait_status(pid);
+  const pid_t pid = start_sonomap(short_run(kSmoke, out, 12), log, 64 * 1024);
+  const int status = wait_status(pid);
   const std::string output = text_of(log);
   fs::remove(log);
   INFO(output);
@@ -84,7 +80,7 @@ TEST_CASE("SIGHUP, SIGTERM and SIGQUIT mid-run exit 128 + signal and leave no pa
   for (int signal : {SIGHUP, SIGTERM, SIGQUIT}) {
     const fs::path out = scratch.path() / ("out" + std::to_string(signal));
     const fs::path log = scratch.path() / ("log" + std::to_string(signal));
-    const pid_t pid = sonomap::test::start_sonomap(short_run(kSmoke, out, 3000), log);
+    const pid_t pid = start_sonomap(short_run(kSmoke, out, 3000), log);
     // Wait until the run has started writing (its staging folder exists), then signal it.
     fs::path staging = out;
     staging += ".partial-" + std::to_string(pid);
@@ -93,7 +89,7 @@ TEST_CASE("SIGHUP, SIGTERM and SIGQUIT mid-run exit 128 + signal and leave no pa
     REQUIRE(fs::exists(staging));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     ::kill(pid, signal);
-    const int status = sonomap::test::wait_status(pid);
+    const int status = wait_status(pid);
     INFO("signal " << signal << ": " << text_of(log));
     CHECK(status == 128 + signal);
     CHECK(!fs::exists(out));
@@ -107,12 +103,12 @@ TEST_CASE("a stale staging folder of a dead process is removed by the next run, 
           "folder of the same shape is not",
           "[safety]") {
   ScratchDir scratch("safety-stale");
-  const std::string dead = std::to_string(sonomap::test::dead_pid());
+  const std::string dead = std::to_string(dead_pid());
   const fs::path stale = scratch.path() / ("old.partial-" + dead);
   scratch.write("old.partial-" + dead + "/" + sonomap::harness::kResultMarker, "sonomap run 0\n");
   scratch.write("old.partial-" + dead + "/frames.csv", "frame\n");
   const fs::path users = scratch.write("photos.partial-" + dead + "/cat.jpg", "cat");
-  const auto result = sonomap::test::run_sonomap(short_run(kSmoke, scratch.path() / "out"));
+  const auto result = run_sonomap(short_run(kSmoke, scratch.path() / "out"));
   INFO(result.output);
   REQUIRE(result.status == 0);
   CHECK(!fs::exists(stale));
