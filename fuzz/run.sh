@@ -20,7 +20,7 @@ CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Relea
 cmake --build "$build" -j"$(nproc)" --target "${readers[@]/#/fuzz_}"
 
 export ASAN_OPTIONS="detect_container_overflow=0:${ASAN_OPTIONS:-}"
-export LSAN_OPTIONS="suppressions=$root/fuzz/lsan.supp:${LSAN_OPTIONS:-}"
+export LSAN_OPTIONS="suppressions=$root/ci/lsan.supp:${LSAN_OPTIONS:-}"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:${UBSAN_OPTIONS:-}"
 status=0
 for reader in "${readers[@]}"; do
