@@ -266,6 +266,11 @@ void prepare_output_directory(const fs::path& out, const std::string& command,
   sync_path(parent_of(out), true);
 }
 
+void mark_as_result(const fs::path& dir, const std::string& command) {
+  write_all(dir / kResultMarker, marker_text(command));
+  sync_path(dir, true);
+}
+
 StagedDirectory::StagedDirectory(const fs::path& final_path, const std::string& command,
                                  const std::vector<fs::path>& inputs)
     : final_(tidy(final_path)), staging_(staging_name(final_)) {

@@ -53,6 +53,9 @@ void check_output_file(const std::filesystem::path& out, const Recognise& ours,
 void prepare_output_directory(const std::filesystem::path& out, const std::string& command,
                               const std::vector<std::filesystem::path>& inputs = {});
 
+// Marks an existing folder as a sonomap result (report, into a folder of runs gathered by hand).
+void mark_as_result(const std::filesystem::path& dir, const std::string& command);
+
 // A result directory built at "<final>.partial-<pid>" (marked from the start, so a staging
 // folder left by a killed process is recognisably ours) and published by commit(), which
 // replaces an earlier result atomically. Destroyed without commit: the staging folder is removed.
