@@ -455,7 +455,7 @@ DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
   std::vector<const GlobalLeaf*> used;
   for (const auto& [d2, leaf] : found) {
     if (d2 > reach * reach) continue;
-    std::call_once(leaf->trained, [&] { leaf->gp.train(leaf->crossings, config_.global_gp_params()); });
+    std::call_once(leaf->trained, [&, leaf = leaf] { leaf->gp.train(leaf->crossings, config_.global_gp_params()); });
     GpPrediction p = leaf->gp.predict(x, true);
     if (!p.valid) continue;
     d_min = std::min(d_min, p.distance);

@@ -161,6 +161,7 @@ void check_options(const BenchMapOptions& o) {
     const std::filesystem::path parent = std::filesystem::path(o.json).parent_path();
     if (!parent.empty() && !std::filesystem::is_directory(parent))
       throw InputError("--json " + o.json + ": the directory " + parent.string() + " does not exist");
+    check_output_file(o.json, is_sonomap_json, {o.scenario});
   }
 }
 
@@ -280,7 +281,7 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
                                     {"open3d_vertices", c.open3d_vertices},
                                     {"tsdf_samples", c.tsdf_samples},
                                     {"median_distance_m", number(c.median_distance)}});
-  write_text_file(o.json, out.dump(2) + "\n");
+  write_text_file(o.json, out.dump(2) + "\n", is_sonomap_json);
 }
 
 void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {

@@ -4,6 +4,7 @@
 #include "harness/app/cli.hpp"
 #include "harness/app/sonify.hpp"
 #include "harness/formats/sofa_io.hpp"
+#include "harness/support/output.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -21,12 +22,15 @@ void add_brir_command(CLI::App& app, const GlobalOptions& global) {
       "brir", "Synthesise BRIRs of a shoebox room (image sources + late tail) on the paper's grid "
               "(azimuth every 3 deg, 0.4..4.0 m) and write one SOFA file per distance");
   add_room_options(*cmd, state->room);
-  cmd->add_option("--out", state->out, "Output directory (replaced atomically)")->required();
+  cmd->add_option("--out", state->out,
+                  "Output directory: new, empty, or an earlier sonomap result (replaced atomically)")
+      ->required();
   cmd->add_option("--author-contact", state->meta.author_contact,
                   "AES69 AuthorContact written in every file")->capture_default_str();
   cmd->add_option("--organization", state->meta.organization,
                   "AES69 Organization written in every file")->capture_default_str();
   cmd->callback([state, &global] {
+    check_output_directory(state->out, {state->room.hrir_file});  // before the work
     const audio::BrirSynthConfig room = room_config(state->room, 48000.0);
     const audio::BrirSet set = synthesize_brirs(room, state->room.hrir_file, global.quiet);
     const Eigen::Vector3d lo = room.room.min_corner, hi = room.room.max_corner;

@@ -56,10 +56,14 @@ int run_cli(int argc, char** argv) {
     return kExitBadInput;
   } catch (const Interrupted&) {
     std::fprintf(stderr, "sonomap: interrupted; partial output removed\n");
-    return kExitInterrupted;
+    return interrupt_exit_status();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sonomap: failure: %s\n", e.what());
     return kExitFailure;
+  }
+  if (interrupt_requested()) {  // after the last check: the output was already whole
+    std::fprintf(stderr, "sonomap: interrupted after the output was complete; it is kept\n");
+    return interrupt_exit_status();
   }
   return 0;
 }

@@ -307,6 +307,7 @@ struct CompareOptions {
 int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   const Sweep sweep = load_sweep(o.sweep_file, o.out);
   const std::string program = self_program();
+  prepare_output_directory(o.out, "compare", {o.sweep_file});
   // `report` reads claims and gates from here, whoever runs the jobs.
   // A sweep edited to have none removes the earlier file (compare wrote it).
   for (const auto& [file, checks] : {std::pair{"claims.json", &sweep.claims}, std::pair{"gates.json", &sweep.gates}}) {
@@ -314,7 +315,6 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
       fs::remove(o.out / file);
       continue;
     }
-    fs::create_directories(o.out);
     write_text_file(o.out / file, claims_to_json(*checks).dump(2) + "\n");
   }
   if (o.emit_jobs) {
@@ -355,7 +355,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
     if (pid < 0) {
       if (errno == EINTR) {
         // Forward the interrupt so each run removes its partial directory.
-        for (const auto& entry : running) ::kill(entry.first, SIGINT);
+        for (const auto& entry : running) ::kill(entry.first, interrupt_signal());
         continue;
       }
       break;
@@ -371,7 +371,7 @@ int run_compare(const CompareOptions& o, const GlobalOptions& global) {
   progress.finish();
   if (interrupt_requested()) {
     std::fprintf(stderr, "compare: interrupted; finished runs are kept, rerun to resume\n");
-    return kExitInterrupted;
+    return interrupt_exit_status();
   }
   for (const auto& f : failed) std::fprintf(stderr, "compare: run failed: %s\n", f.c_str());
   const ReportOutcome report = build_report(o.out, global.quiet, o.junit);
@@ -386,7 +386,10 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global) {
       "compare", "Run every combination of a sweep file (scenarios x variants x seeds), each an "
                  "independent run, then roll them up into a report");
   cmd->add_option("sweep", o->sweep_file, "Sweep file (YAML)")->required();
-  cmd->add_option("--out", o->out, "Output directory (runs/, logs/, rollup.csv, report.md)")->required();
+  cmd->add_option("--out", o->out,
+                  "Output directory (runs/, logs/, rollup.csv, report.md): new, empty, or an "
+                  "earlier compare result (resumed)")
+      ->required();
   cmd->add_option("-j,--jobs", o->jobs, "Runs at the same time")->check(CLI::PositiveNumber)->capture_default_str();
   cmd->add_flag("--emit-jobs", o->emit_jobs,
                 "Print one command per run (for GNU parallel or a Slurm array) and exit; "

@@ -16,7 +16,8 @@ namespace {
 
 class SimulatedSource final : public FrameSource {
  public:
-  SimulatedSource(sim::Scenario scenario, const fs::path& file) : scenario_(std::move(scenario)) {
+  SimulatedSource(sim::Scenario scenario, const fs::path& file)
+      : scenario_(std::move(scenario)), inputs_(scenario_inputs(scenario_, file)) {
     try {
       simulation_ = std::make_unique<sim::Simulation>(scenario_);
     } catch (const std::invalid_argument& e) {
@@ -34,9 +35,11 @@ class SimulatedSource final : public FrameSource {
   std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
     return sim::world_triangles(scenario_, t);
   }
+  std::vector<fs::path> inputs() const override { return inputs_; }
 
  private:
   sim::Scenario scenario_;
+  std::vector<fs::path> inputs_;
   std::unique_ptr<sim::Simulation> simulation_;
 };
 
@@ -44,7 +47,8 @@ class SimulatedSource final : public FrameSource {
 // system gave, its world turned z-up with the floor where the sequence file puts it.
 class RecordedSource final : public FrameSource {
  public:
-  RecordedSource(const fs::path& input, int frames) : sequence_(open_recorded_sequence(input)) {
+  RecordedSource(const fs::path& input, int frames)
+      : sequence_(open_recorded_sequence(input)), input_(input) {
     count_ = sequence_->frame_count();
     if (frames > 0) count_ = std::min(count_, frames);
   }
@@ -59,13 +63,24 @@ class RecordedSource final : public FrameSource {
   double ground_z() const override { return sequence_->ground_z(); }
   std::uint64_t seed() const override { return 0; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }
+  std::vector<fs::path> inputs() const override { return {input_}; }
 
  private:
   std::unique_ptr<RecordedSequence> sequence_;
+  fs::path input_;  // the folder or the sequence file
   int count_ = 0;
 };
 
 }  // namespace
+
+std::vector<fs::path> scenario_inputs(const sim::Scenario& scenario, const fs::path& file) {
+  std::vector<fs::path> files{file};
+  for (const auto& object : scenario.statics)
+    if (!object.shape.mesh_path.empty()) files.emplace_back(object.shape.mesh_path);
+  for (const auto& object : scenario.movers)
+    if (!object.shape.mesh_path.empty()) files.emplace_back(object.shape.mesh_path);
+  return files;
+}
 
 std::unique_ptr<FrameSource> open_frame_source(const fs::path& input,
                                                std::vector<std::string> overrides, int frames,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "sim/scenario.hpp"
 #include "sim/world_geometry.hpp"
 
 #include <cstdint>
@@ -32,7 +33,13 @@ class FrameSource {
   virtual std::uint64_t seed() const = 0;
   // World triangles at time t, or nullopt when there is no ground truth (recorded data).
   virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
+  // The files and folders it reads (no output may be, contain or lie inside one).
+  virtual std::vector<std::filesystem::path> inputs() const = 0;
 };
+
+// A scenario's files: the YAML itself and the meshes it names.
+std::vector<std::filesystem::path> scenario_inputs(const sim::Scenario& scenario,
+                                                   const std::filesystem::path& file);
 
 // The frame source a run's input names: a directory (a recorded TUM RGB-D sequence) or a
 // sequence file (sequence.yaml, or a top-level `sequence:` key) is a recording (its first

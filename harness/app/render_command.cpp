@@ -3,6 +3,7 @@
 #include "harness/app/render_command.hpp"
 
 #include "harness/app/cli.hpp"
+#include "harness/app/frame_source.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/formats/tum_io.hpp"
 #include "harness/support/errors.hpp"
@@ -29,18 +30,6 @@ struct RenderOptions {
   std::vector<std::string> overrides;
 };
 
-// Replacing --out must never delete something that is not ours: only an empty directory or
-// an earlier sequence may be replaced.
-void check_replaceable(const fs::path& out) {
-  std::error_code ec;
-  if (!fs::exists(out, ec)) return;
-  const bool empty_dir = fs::is_directory(out, ec) && fs::is_empty(out, ec);
-  const bool sequence = fs::is_regular_file(out / "depth.txt", ec) &&
-                        fs::is_regular_file(out / "camera.yaml", ec);
-  if (!empty_dir && !sequence)
-    throw InputError(out.string() + ": exists and is not a depth sequence; choose another --out");
-}
-
 }  // namespace
 
 void render_sequence(const fs::path& scenario_file, const std::vector<std::string>& overrides,
@@ -61,9 +50,7 @@ void render_sequence(const fs::path& scenario_file, const std::vector<std::strin
     throw InputError(scenario_file.string(), 0, "", e.what());
   }
 
-  check_replaceable(out);
-  install_interrupt_handler();  // Ctrl-C unwinds: the staged directory is removed
-  StagedDirectory staged(out, /*replace=*/true);
+  StagedDirectory staged(out, "render", scenario_inputs(scenario, scenario_file));
   TumWriter writer(staged.path(), camera);
   const int frames = simulation->frame_count();
   Progress progress("render", frames, quiet);
@@ -90,8 +77,8 @@ void add_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("scenario", options->scenario, "Scenario file (format: scenes/README.md)")
       ->required();
   command->add_option("--out", options->out,
-                      "Output directory: written whole or not at all; an earlier sequence there "
-                      "is replaced")
+                      "Output directory: written whole or not at all; new, empty, or an earlier "
+                      "sonomap result (which is replaced)")
       ->required();
   command->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
       ->check(CLI::Range(1, kMaxFrames));

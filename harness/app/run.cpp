@@ -8,6 +8,7 @@
 #include "harness/app/frame_outputs.hpp"
 #include "harness/app/run_results.hpp"
 #include "harness/app/run_setup.hpp"
+#include "harness/app/sonify.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/fields.hpp"
 #include "harness/support/interrupt.hpp"
@@ -83,7 +84,9 @@ RunOutcome run_scenario(const RunOptions& options) {
   FrameSource& source = *inputs.source;
   const FrameSchedule schedule(options, inputs.settings, source.frame_count());
 
-  StagedDirectory staged(options.out);
+  std::vector<fs::path> input_paths = source.inputs();
+  input_paths.push_back(options.brir_dir.empty() ? default_hrir_file() : options.brir_dir);
+  StagedDirectory staged(options.out, "run", input_paths);
   RunResults results(staged.path(), options.write_rasters);
   FrameOutputs outputs(staged.path(), options, schedule, source.name(), mapper->name(),
                        inputs.settings.raster);
@@ -157,7 +160,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Scenario YAML file, a recorded TUM RGB-D directory (depth.txt, groundtruth.txt,\n"
                   "depth/*.png, camera.yaml), or a sequence file (sequence.yaml: a folder of depth\n"
                   "PNGs or a ROS1 bag; docs/real-data.md). Recordings: no ground truth, no metrics")->required();
-  cmd->add_option("--out", options->out, "Result directory (written atomically)")->required();
+  cmd->add_option("--out", options->out,
+                  "Result directory (written atomically): new, empty, or an earlier sonomap result")
+      ->required();
   cmd->add_option("--frames", options->frames, "Number of frames (default: the scenario's)")
       ->check(CLI::Range(1, kMaxFrames));
   cmd->add_option("--every", options->every,

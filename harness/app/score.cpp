@@ -249,7 +249,9 @@ json score_rasters(const ScoreOptions& o) {
   std::unique_ptr<FrameSource> source = open_frame_source(o.scenario, scenario_overrides, o.frames, o.seed);
   const int frame_count = source->frame_count();
 
-  StagedDirectory staged(o.out);
+  std::vector<fs::path> inputs = source->inputs();
+  inputs.insert(inputs.end(), {o.circle, o.cylinder, o.sequence_cache});
+  StagedDirectory staged(o.out, "score", inputs);
   const fs::path dir = staged.path();
   fs::path circle_file = o.circle, cylinder_file = o.cylinder;
   if (!o.command.empty()) {

@@ -210,10 +210,14 @@ std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quie
   return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet));
 }
 
+namespace {
+const char* const kEventsHeader =
+    "time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,pitch_semitones,sound,"
+    "gain_db,loudness_lufs,true_peak_dbtp";
+}  // namespace
+
 std::string sweep_events_csv(const audio::SweepAudio& audio) {
-  std::string out =
-      "time_s,sector,azimuth_deg,range_m,brir_distance_m,brir_azimuth_deg,pitch_semitones,sound,"
-      "gain_db,loudness_lufs,true_peak_dbtp\n";
+  std::string out = std::string(kEventsHeader) + "\n";
   // The file's level, the same on every row: one gain for the whole sweep.
   char level[96];
   std::snprintf(level, sizeof level, "%.2f,%.2f,%.2f", audio.gain_db,
@@ -236,9 +240,18 @@ fs::path events_path_for(const fs::path& wav) {
   return p;
 }
 
+bool is_sonomap_sweep(const fs::path& file) {
+  return first_line_is(file.extension() == ".csv" ? file : events_path_for(file), kEventsHeader);
+}
+
+void check_sweep_output(const fs::path& wav, const std::vector<fs::path>& inputs) {
+  check_output_file(wav, is_sonomap_sweep, inputs);
+  check_output_file(events_path_for(wav), is_sonomap_sweep, inputs);
+}
+
 void write_sweep(const audio::SweepAudio& audio, const fs::path& wav) {
-  StagedFile wav_file(wav);
-  StagedFile events_file(events_path_for(wav));
+  StagedFile wav_file(wav, is_sonomap_sweep);
+  StagedFile events_file(events_path_for(wav), is_sonomap_sweep);
   write_wav(wav_file.path(), audio.sample_rate, audio.left, audio.right);
   {
     std::FILE* f = std::fopen(events_file.path().c_str(), "wb");

@@ -67,6 +67,13 @@ std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& setup, bool 
 std::string sweep_events_csv(const audio::SweepAudio& audio);
 // "sweep.wav" -> "sweep.events.csv"
 std::filesystem::path events_path_for(const std::filesystem::path& wav);
+// A sweep sonomap wrote (the WAV or its event CSV): the event CSV starts with the event log's
+// header. Only such files are replaced by a new sweep (docs/outputs.md).
+bool is_sonomap_sweep(const std::filesystem::path& file);
+// The output checks of a sweep (WAV and event CSV), before the work: InputError if either
+// exists and is not a sweep sonomap wrote, or is an input.
+void check_sweep_output(const std::filesystem::path& wav,
+                        const std::vector<std::filesystem::path>& inputs);
 // Writes the WAV and its event CSV, each staged and renamed: no partial files on failure.
 // audio.gain_db / audio.loudness are the figures a run's summary carries.
 void write_sweep(const audio::SweepAudio& audio, const std::filesystem::path& wav);

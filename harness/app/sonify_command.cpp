@@ -21,9 +21,13 @@ void add_sonify_command(CLI::App& app, const GlobalOptions& global) {
       "sonify", "Render one binaural sweep of a circle CSV (header 'bin,range', 360 rows, empty "
                 "range = unknown) to a stereo WAV and an event CSV");
   cmd->add_option("circle", state->circle, "Circle CSV")->required();
-  cmd->add_option("--out", state->out, "Output WAV (events go to <name>.events.csv)")->required();
+  cmd->add_option("--out", state->out,
+                  "Output WAV (events go to <name>.events.csv); replaces only a sweep sonomap wrote")
+      ->required();
   add_sonify_options(*cmd, state->setup);
   cmd->callback([state, &global] {
+    const std::filesystem::path& brirs = state->setup.brir_dir;
+    check_sweep_output(state->out, {state->circle, brirs.empty() ? state->setup.room.hrir_file : brirs});
     const Circle circle = read_circle_csv(state->circle);
     check_sweep_options(state->setup);
     audio::SweepRenderer renderer(load_brirs(state->setup, global.quiet), state->setup.sweep);

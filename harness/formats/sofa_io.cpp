@@ -87,6 +87,12 @@ Eigen::Matrix3d head_frame(const MYSOFA_HRTF& h) {
 SofaContents read_sofa(const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) bad(file, "not a readable file");
+  // libmysofa 1.3.1 can loop for minutes on a corrupt HDF5 file (found by fuzz/fuzz_sofa);
+  // netCDF's HDF5 reader refuses such files at once, so it checks the container first.
+  int ncid = 0;
+  if (const int rc = nc_open(file.c_str(), NC_NOWRITE, &ncid); rc != NC_NOERR)
+    bad(file, std::string("not a SOFA (netCDF-4/HDF5) file: ") + nc_strerror(rc));
+  nc_close(ncid);
   int err = 0;
   std::unique_ptr<MYSOFA_HRTF, HrtfDeleter> hrtf(mysofa_load(file.c_str(), &err));
   if (!hrtf || err != MYSOFA_OK) bad(file, "libmysofa cannot load it: " + mysofa_error_name(err));
@@ -466,7 +472,7 @@ void write_brir_sofa(const fs::path& file, double sample_rate, double distance_m
 
 void write_brir_directory(const fs::path& directory, const audio::BrirSet& set,
                           const SofaMetadata& meta) {
-  StagedDirectory staged(directory, true);
+  StagedDirectory staged(directory, "brir");
   const size_t na = set.azimuth_count();
   for (size_t d = 0; d < set.distance_count(); ++d) {
     std::vector<audio::BinauralIr> irs;

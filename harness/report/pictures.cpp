@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/report/pictures.hpp"
 
+#include "harness/support/output.hpp"
 #include "harness/support/subprocess.hpp"
 
 #include <algorithm>
@@ -40,11 +41,7 @@ std::string quoted(const std::string& s) {
 
 void draw_with_gnuplot(const fs::path& png, const std::string& script_text) {
   const fs::path script = fs::path(png).replace_extension(".gp");
-  {
-    std::ofstream out(script);
-    out << script_text;
-    if (!out) throw std::runtime_error("cannot write " + script.string());
-  }
+  write_text_file(script, script_text);
   run_gnuplot(script);
   fs::remove(script);
 }

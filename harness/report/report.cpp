@@ -299,9 +299,21 @@ void add_report_command(CLI::App& app, const GlobalOptions& global) {
   CLI::App* cmd = app.add_subcommand(
       "report", "Roll up the finished runs under DIR/runs into rollup.csv, rollup_stats.csv, "
                 "pairs.csv, plots and report.md; exit status 1 when a gate fails");
-  cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (or holding runs/)")->required();
+  cmd->add_option("dir", *dir, "Directory written by `sonomap compare` (also with --emit-jobs)")
+      ->required();
   cmd->add_option("--junit", *junit, "Also write JUnit XML: one test case per gate and claim");
   cmd->callback([dir, junit, &global] {
+    // It writes its roll-ups and plots/ there: into a folder sonomap made, or one that has
+    // none of them yet (runs/ gathered by hand), which it then marks as its own.
+    if (!is_sonomap_result(*dir)) {
+      if (!fs::is_directory(*dir / "runs"))
+        throw InputError(dir->string() + " is not a sonomap result and holds no runs/");
+      for (const char* name : {"rollup.csv", "rollup_stats.csv", "pairs.csv", "report.md", "plots"})
+        if (fs::exists(*dir / name))
+          throw InputError((*dir / name).string() + " exists and was not written by sonomap; "
+                           "report writes only into a folder `sonomap compare` made");
+      mark_as_result(*dir, "report");
+    }
     if (build_report(*dir, global.quiet, *junit).failed_gates > 0) throw CLI::RuntimeError(kExitFailure);
   });
 }
