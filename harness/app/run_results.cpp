@@ -3,6 +3,7 @@
 
 #include "harness/app/result_files.hpp"
 #include "harness/formats/mesh_io.hpp"
+#include "harness/support/output.hpp"
 
 #include <fmt/format.h>
 
@@ -40,9 +41,7 @@ std::string frame_row_csv(const FrameRow& r) {
 ResultFile::ResultFile(fs::path path) : path_(std::move(path)), out_(path_) {}
 
 void ResultFile::close() {
-  if (!out_.is_open()) return;
-  out_.close();
-  if (out_.fail()) throw std::runtime_error("writing " + path_.string() + " failed");
+  if (out_.is_open()) close_checked(out_, path_);
 }
 
 void write_result_file(const fs::path& path, const std::string& text) {
