@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Mappers by name. The built-in ones (vdb_gpdf, tsdf, depth_only) are registered here exactly
-// like a user's: a program built on sonomap calls register_mapper() before cli_main() and its
-// mapper is selectable with `--mapper NAME` and in sweep variants (docs/sdk.md).
+// Mappers by name. The built-in ones (vdb_gpdf, tsdf, open3d, depth_only) are registered here
+// exactly like a user's: a program built on sonomap calls register_mapper() before cli_main()
+// and its mapper is selectable with `--mapper NAME` and in sweep variants (docs/sdk.md).
 #pragma once
 
 #include "core/mapper.hpp"

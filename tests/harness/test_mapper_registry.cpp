@@ -39,9 +39,9 @@ std::unique_ptr<sonomap::Mapper> recording_factory(double voxel,
 TEST_CASE("mapper registry: a registered mapper sits after the built-ins and gets the run's voxel and settings") {
   sonomap::register_mapper("registry-test_1", recording_factory);
   const auto names = mapper_names();
-  REQUIRE(names.size() >= 4);
-  CHECK(std::vector<std::string>(names.begin(), names.begin() + 3) ==
-        std::vector<std::string>{"vdb_gpdf", "tsdf", "depth_only"});
+  REQUIRE(names.size() >= 5);
+  CHECK(std::vector<std::string>(names.begin(), names.begin() + 4) ==
+        std::vector<std::string>{"vdb_gpdf", "tsdf", "open3d", "depth_only"});
   CHECK(names.back() == "registry-test_1");
 
   const auto mapper = make_mapper("registry-test_1", 0.2, {{"ok", "3", "--set mapper.ok=3"}});
@@ -61,14 +61,14 @@ TEST_CASE("mapper registry: a registered mapper sits after the built-ins and get
     make_mapper("registry-test_2", 0.0, {});
     FAIL("an unknown mapper was built");
   } catch (const InputError& e) {
-    CHECK(std::string(e.what()).find("known: vdb_gpdf, tsdf, depth_only, registry-test_1)") !=
+    CHECK(std::string(e.what()).find("known: vdb_gpdf, tsdf, open3d, depth_only, registry-test_1)") !=
           std::string::npos);
   }
   CHECK_THROWS_AS(make_mapper("registry-test_1", -0.1, {}), InputError);
 }
 
 TEST_CASE("mapper registry: malformed names, taken names and empty factories are refused") {
-  for (const std::string name : {"", "two words", "a/b", "vdb_gpdf", "depth_only"})
+  for (const std::string name : {"", "two words", "a/b", "vdb_gpdf", "open3d", "depth_only"})
     CHECK_THROWS_AS(sonomap::register_mapper(name, recording_factory), std::invalid_argument);
   CHECK_THROWS_AS(sonomap::register_mapper("empty", sonomap::MapperFactory{}), std::invalid_argument);
   sonomap::register_mapper("once", recording_factory);
