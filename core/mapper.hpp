@@ -69,8 +69,8 @@ class Mapper {
     vertices.clear();
     triangles.clear();
   }
-  // The configuration as (key, value) text, for summary.json. A "voxel" (or "global_voxel")
-  // entry sets the ghost tolerance of the metrics to two voxels.
+  // The configuration as (key, value) text, for summary.json. A registered mapper's "voxel"
+  // entry (metres) sets the ghost tolerance of the metrics to two voxels.
   virtual std::vector<std::pair<std::string, std::string>> config_entries() const { return {}; }
   // Bytes held by the map (grids, caches); 0 if the map does not know.
   virtual size_t memory_bytes() const { return 0; }
