@@ -1,5 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// One interface for every map, so an A/B run swaps the mapper and nothing else.
+// One interface for every map, so an A/B run swaps the mapper and nothing else. This is the
+// public contract a mapper of your own implements (docs/sdk.md; frames: docs/conventions.md).
+//
+// How a run drives a mapper: a factory (harness/app/mapper_registry.hpp) builds one fresh
+// mapper per run; config_entries() is read once; then for every frame in order, integrate()
+// and last_stage_times(); on evaluated frames surface_points() around the listener (and, when
+// the EDF comparison is on, query()); surface_mesh() once at the end; memory_bytes() by
+// `bench map`.
+// Thread-safety: the harness never calls one mapper from two threads at once, and const calls
+// never overlap integrate(). A mapper may use TBB inside its calls (`--threads` caps it), but
+// its results must not depend on the thread count or on timing: same frames, same output.
+// Errors: std::invalid_argument for bad input (an unusable frame, a bad setting in the
+// factory) stops the run with exit status 2 and a message naming the frame or setting; any
+// other exception is a failure (exit status 1). A mapper never prints and never touches files.
 #pragma once
 
 #include "core/types.hpp"
@@ -29,17 +42,25 @@ struct StageTimes {
 class Mapper {
  public:
   virtual ~Mapper() = default;
+  // The name results record (summary.json "mapper"), e.g. "vdb_gpdf".
   virtual std::string name() const = 0;
-  // Fuses one frame (points in the camera frame, frame.world_T_camera as the pose).
-  // Frames with invalid poses or points are rejected with std::invalid_argument, map untouched.
+  // Fuses one frame: frame.points_camera (valid returns only, camera optical frame: x right,
+  // y down, z forward, metres) placed with frame.world_T_camera, the localisation estimate
+  // (world z up). frame.depth is the same data as an image. The *_true poses are for ground
+  // truth only: a mapper must not read them. Frames with invalid poses or points are rejected
+  // with std::invalid_argument, map untouched (check_pose() and world_points() below help).
   virtual void integrate(const Frame& frame) = 0;
-  // Surface samples in the world within `radius` (horizontal) of `center`, dense enough that
-  // neighbouring samples of one continuous surface are at most about half a voxel apart.
+  // Replaces `out` with surface samples in the world within `radius` (horizontal distance) of
+  // `center` (the listener's estimated position), dense enough that neighbouring samples of one
+  // continuous surface are at most about half a voxel apart. The rasters take the samples in
+  // the obstacle band; their order must be the same on every run.
   virtual void surface_points(const Eigen::Vector3d& center, double radius,
                               std::vector<Eigen::Vector3f>& out) const = 0;
-  // Distance field queries (batched). Maps without a field report observed = false.
+  // Distance field queries (batched, world points): `out` gets exactly one answer per point.
+  // Maps without a field answer observed = false everywhere.
   virtual void query(const std::vector<Eigen::Vector3f>& points,
                      std::vector<DistanceQuery>& out) const = 0;
+  // The stages of the last integrate() with their times (timings.csv "map.<stage>").
   virtual StageTimes last_stage_times() const { return {}; }
   // The whole surface as a triangle mesh in the world (the harness writes it as PLY).
   // Maps without a mesh leave both empty.
@@ -48,7 +69,8 @@ class Mapper {
     vertices.clear();
     triangles.clear();
   }
-  // The configuration as (key, value) text, for summary.json.
+  // The configuration as (key, value) text, for summary.json. A registered mapper's "voxel"
+  // entry (metres) sets the ghost tolerance of the metrics to two voxels.
   virtual std::vector<std::pair<std::string, std::string>> config_entries() const { return {}; }
   // Bytes held by the map (grids, caches); 0 if the map does not know.
   virtual size_t memory_bytes() const { return 0; }

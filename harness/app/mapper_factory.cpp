@@ -7,6 +7,7 @@
 #include "harness/support/errors.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 namespace sonomap::harness {
@@ -85,23 +86,15 @@ void for_each_default_table(Use use) {
 
 }  // namespace
 
-std::vector<std::string> mapper_names() { return {"vdb_gpdf", "tsdf", "open3d", "depth_only"}; }
-
-std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
-                                    const std::vector<Setting>& settings) {
-  if (voxel != 0.0 && !(voxel >= kMinVoxel && voxel <= kMaxVoxel))
-    throw InputError("--voxel " + number_text(voxel) + ": expected a voxel size in [" +
-                     number_text(kMinVoxel) + ", " + number_text(kMaxVoxel) + "] m");
-  if (name == "vdb_gpdf") return make_vdb_gpdf(voxel, settings);
-  if (name == "tsdf") return make_tsdf(voxel, settings);
-  if (name == "open3d") return make_open3d(voxel, settings);
-  if (name == "depth_only") {
-    apply({}, name, settings);
+std::vector<std::pair<std::string, MapperFactory>> builtin_mappers() {
+  const auto depth_only = [](double, const std::vector<Setting>& settings) -> std::unique_ptr<Mapper> {
+    apply({}, "depth_only", settings);
     return std::make_unique<DepthOnlyMapper>();
-  }
-  std::string names;
-  for (const auto& n : mapper_names()) names += (names.empty() ? "" : ", ") + n;
-  throw InputError("--mapper " + name + ": unknown mapper (known: " + names + ")");
+  };
+  return {{"vdb_gpdf", make_vdb_gpdf},
+          {"tsdf", make_tsdf},
+          {"open3d", make_open3d},
+          {"depth_only", depth_only}};
 }
 
 std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Mapper& mapper) {
@@ -118,6 +111,8 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
   } else if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) {
     Open3dTsdfConfig c = o->config();
     add(open3d_fields(c));
+  } else {
+    for (const auto& entry : mapper.config_entries()) entries.push_back(entry);  // registered
   }
   return entries;
 }
@@ -126,6 +121,11 @@ double mapper_voxel(const Mapper& mapper) {
   if (const auto* v = dynamic_cast<const VdbGpdf*>(&mapper)) return v->config().global_voxel;
   if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) return t->config().voxel;
   if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) return o->config().voxel;
+  for (const auto& [key, value] : mapper.config_entries()) {  // a registered mapper
+    char* end = nullptr;
+    const double voxel = key == "voxel" ? std::strtod(value.c_str(), &end) : 0.0;
+    if (end && *end == '\0' && std::isfinite(voxel) && voxel > 0.0) return voxel;
+  }
   return 0.0;
 }
 

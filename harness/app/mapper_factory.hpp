@@ -4,36 +4,25 @@
 // (harness/app/config_fields.hpp): the same table records the config in summary.json.
 #pragma once
 
-#include "core/mapper.hpp"
+#include "harness/app/mapper_registry.hpp"
 
-#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace sonomap::harness {
 
-// A setting as the user wrote it: the field (without "mapper."), its value, and where it came
-// from (e.g. "--set mapper.voxel=0.1"), for error messages.
-struct Setting {
-  std::string key;
-  std::string value;
-  std::string source;
-};
-
-// The names `--mapper` accepts.
-std::vector<std::string> mapper_names();
-
-// voxel > 0 sets the global voxel size (the `--voxel` option; 0: the mapper's default). Throws
-// InputError for an unknown mapper, an unknown field or a value out of range, naming the setting.
-std::unique_ptr<Mapper> make_mapper(const std::string& name, double voxel,
-                                    const std::vector<Setting>& settings);
+// The built-in mappers with their factories, in the order `--mapper` lists them.
+// make_mapper() and mapper_names() (mapper_registry.hpp) serve them and the ones a program
+// registers.
+std::vector<std::pair<std::string, MapperFactory>> builtin_mappers();
 
 // The mapper's whole config, every field of its table with its value (summary.json's
-// mapper_config), after "mapper": name.
+// mapper_config), after "mapper": name. A registered mapper gives its config_entries().
 std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Mapper& mapper);
 
-// The mapper's (global) voxel size in metres; 0 for a mapper without a grid.
+// The mapper's (global) voxel size in metres; 0 for a mapper without a grid. A registered
+// mapper gives its config_entries() "voxel", if any.
 double mapper_voxel(const Mapper& mapper);
 // Estimated bytes of the mapper's map over `surface_area` m^2 of surfaces: VDB leaves of 8^3
 // (distance, weight) voxels along the surfaces, two deep for the truncation band. On the smoke
