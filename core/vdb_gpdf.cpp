@@ -22,9 +22,6 @@ namespace {
 using Clock = StageClock;
 
 constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
-// A voxel the map holds as free by more than this many global voxels that this frame sees a
-// surface in (or behind) has changed: an object came into view there.
-constexpr double kReoccupiedVoxels = 2.0;
 constexpr double kNearCarveReach = 0.25;  // voxels; see near_surface()
 // A voxel the map holds as behind a surface that this frame sees only as free, by more than
 // this many voxels on average, has been vacated: an object left.
@@ -403,22 +400,19 @@ void VdbGpdf::integrate(const Frame& frame) {
     auto acc = fused_.grid().getAccessor();
     auto hit_acc = hits.getConstAccessor();
     const bool capped = config_.weight_cap > 0.0;
-    const float free_beyond = static_cast<float>(-kReoccupiedVoxels * config_.global_voxel);
     const float vacated_below = static_cast<float>(-kVacatedVoxels * config_.global_voxel);
     for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
       for (auto v = leaf->cbeginValueOn(); v; ++v) {
         const openvdb::Vec2s sum = *v;
         const openvdb::Vec2s old = acc.getValue(v.getCoord());
-        // Space the map knew as free, where this frame sees a surface: what it knew is out of
-        // date (an object came into view), so this frame's value replaces it at once instead
-        // of being outweighed by up to weight_cap frames of free space.
-        // And the other way: space the map knew as behind a surface that this frame sees only
-        // as free, by more than a voxel (so not the inside of a thin wall seen from its other
-        // side): the object has left.
-        const bool hit = hit_acc.isValueOn(v.getCoord());
-        const bool reoccupied = old[0] < free_beyond && hit;
-        const bool vacated = old[0] > 0.0f && !hit && sum[0] < vacated_below * sum[1];
-        const float w_old = reoccupied || vacated ? 0.0f : old[1];
+        // Space the map knew as behind a surface that this frame sees only as free, by more
+        // than a voxel on average (so not the inside of a thin wall seen from its other side):
+        // the object has left, and this frame's value replaces the old one at once instead of
+        // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
+        // voxels only the floor's front queries reach, took 20 frames to clear).
+        const bool vacated = old[0] > 0.0f && !hit_acc.isValueOn(v.getCoord()) &&
+                             sum[0] < vacated_below * sum[1];
+        const float w_old = vacated ? 0.0f : old[1];
         const float w_new = w_old + sum[1];
         const float d_new = (old[0] * w_old + sum[0]) / w_new;
         acc.setValue(v.getCoord(),
