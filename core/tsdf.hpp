@@ -13,7 +13,9 @@ namespace sonomap {
 struct TsdfConfig {
   double voxel = 0.05;       // m
   double truncation = 0.15;  // m (3 voxels)
-  bool space_carving = false;  // VDBFusion's default; trace from the sensor when on
+  // Trace from the sensor (on) or from truncation in front of the point (VDBFusion's default).
+  // On, like VDB-GPDF's free-space carving, so A/B runs compare like with like.
+  bool space_carving = true;
   double weight_cap = 30.0;    // per-update weight ceiling (0 = none)
   double min_weight = 0.1;     // for queries and the surface
   double min_range = 0.1;

@@ -91,16 +91,17 @@ TEST_CASE("VDB-GPDF: a removed box's bins return to the wall behind it within th
 
 TEST_CASE("TSDF peer: a removed box is cleared with space carving and stays without it",
           "[tsdf][dynamic]") {
-  TsdfConfig carving;
-  carving.space_carving = true;
-  Tsdf with_carving(carving);
+  Tsdf with_carving;  // the default
+  REQUIRE(with_carving.config().space_carving);
   const auto [before, frames] = frames_to_clear(with_carving, 100);
   INFO("with carving: box bins " << before.on_box << ", frames to clear " << frames);
   REQUIRE(before.on_box >= 12);
   CHECK(frames >= 1);
   CHECK(frames <= 40);  // a weight cap of 30: the old value keeps at most 30/31 per frame
 
-  Tsdf without_carving;  // VDBFusion's default
+  TsdfConfig plain;
+  plain.space_carving = false;  // VDBFusion's default
+  Tsdf without_carving(plain);
   const auto [before_plain, frames_plain] = frames_to_clear(without_carving, 100);
   INFO("without carving: box bins " << before_plain.on_box << ", frames to clear " << frames_plain);
   REQUIRE(before_plain.on_box >= 12);

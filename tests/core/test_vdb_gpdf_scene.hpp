@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -80,9 +81,21 @@ inline Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector
   return t;
 }
 
-// A noise-free pinhole depth frame (coarse by default to keep tests fast).
+// Deterministic integer hash (splitmix64) for the mixed-pixel model below.
+inline uint64_t mix_bits(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// A pinhole depth frame (coarse by default to keep tests fast). Noise-free unless
+// `mixed_pixels`: then every pixel reports the depth of a neighbour up to one pixel away
+// (chosen by a hash of frame index and pixel), as a structured-light camera's lateral jitter
+// does, so at silhouette edges some rays report the background through the object's edge.
 inline Frame render(const Scene& scene, const Eigen::Isometry3d& world_T_camera, int index = 0,
-                    int width = 160, int height = 120, double max_range = 5.0) {
+                    int width = 160, int height = 120, double max_range = 5.0,
+                    bool mixed_pixels = false) {
   Frame f;
   f.index = index;
   f.width = width;
@@ -92,15 +105,27 @@ inline Frame render(const Scene& scene, const Eigen::Isometry3d& world_T_camera,
   f.world_T_body = world_T_camera;
   const double fx = 0.82 * width, fy = fx, cx = (width - 1) / 2.0, cy = (height - 1) / 2.0;
   f.intrinsics = PinholeIntrinsics{fx, fy, cx, cy};
+  std::vector<float> z(static_cast<size_t>(width) * height, 0.0f);  // exact depth per pixel
   for (int v = 0; v < height; ++v)
     for (int u = 0; u < width; ++u) {
-      const Eigen::Vector3d ray_cam((u - cx) / fx, (v - cy) / fy, 1.0);
-      const Eigen::Vector3d dir_cam = ray_cam.normalized();
+      const Eigen::Vector3d dir_cam = Eigen::Vector3d((u - cx) / fx, (v - cy) / fy, 1.0).normalized();
       const double t = scene.cast(world_T_camera.translation(), world_T_camera.linear() * dir_cam);
-      if (!(t <= max_range)) continue;
-      const Eigen::Vector3d pc = t * dir_cam;
-      f.depth[static_cast<size_t>(v) * width + u] = static_cast<float>(pc.z());
-      f.points_camera.push_back(pc.cast<float>());
+      if (t <= max_range) z[static_cast<size_t>(v) * width + u] = static_cast<float>(t * dir_cam.z());
+    }
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      int su = u, sv = v;
+      if (mixed_pixels) {
+        const uint64_t h = mix_bits((static_cast<uint64_t>(index) << 40) ^ (static_cast<uint64_t>(v) << 20) ^ u);
+        su = std::clamp(u + static_cast<int>(h % 3) - 1, 0, width - 1);
+        sv = std::clamp(v + static_cast<int>((h / 3) % 3) - 1, 0, height - 1);
+      }
+      const float depth = z[static_cast<size_t>(sv) * width + su];
+      if (!(depth > 0.0f)) continue;
+      const Eigen::Vector3d ray_cam((u - cx) / fx, (v - cy) / fy, 1.0);  // z = 1: scale by depth
+      if ((depth * ray_cam).norm() > max_range) continue;
+      f.depth[static_cast<size_t>(v) * width + u] = depth;
+      f.points_camera.push_back((depth * ray_cam).cast<float>());
     }
   return f;
 }
