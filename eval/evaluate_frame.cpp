@@ -11,7 +11,7 @@ namespace {
 // Metrics of an estimate with nothing to compare against: only its known cells count.
 RasterMetrics without_truth(int estimate_known) {
   RasterMetrics m;
-  m.coverage = m.rmse = NAN;
+  m.coverage = m.rmse = m.rmse_off_edges = NAN;  // no truth: no error, not zero error
   m.estimate_known = estimate_known;
   return m;
 }
@@ -26,7 +26,6 @@ void evaluate_edf(const Mapper& mapper, const RasterOrigin& origin, const Evalua
     out.edf_circle = compare(out.edf->traced, out.truth.circle, config.metrics);
   } else {
     out.edf_circle = without_truth(out.edf->traced.known_count());
-    out.edf_circle.rmse_off_edges = NAN;
   }
 }
 

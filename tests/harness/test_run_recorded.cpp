@@ -38,6 +38,23 @@ TEST_CASE("a rendered TUM sequence gives the simulator's circle within the depth
   const auto summary = sonomap::harness::run_scenario(recorded).summary;
   CHECK_FALSE(summary.ground_truth);
   CHECK_FALSE(summary.circle.final_frame.has_value());
+  {
+    // Without truth there is no error to report, not an error of zero: every metric cell of
+    // frames.csv is empty (only the known counts are filled).
+    std::ifstream frames(recorded.out / "frames.csv");
+    std::string header, row;
+    REQUIRE(std::getline(frames, header));
+    REQUIRE(std::getline(frames, row));
+    const auto column = [](const std::string& line, const std::string& name, const std::string& head) {
+      std::stringstream h(head), l(line);
+      std::string hn, lv;
+      while (std::getline(h, hn, ',') && std::getline(l, lv, ','))
+        if (hn == name) return lv;
+      return std::string("missing");
+    };
+    for (const char* name : {"circle_rmse", "circle_rmse_off_edges", "cylinder_rmse_off_edges"})
+      CHECK(column(row, name, header).empty());
+  }
 
   // Rounding z to the PNG unit moves a point by at most half a unit (0.1 mm) of z, so by
   // 0.1 mm x |ray| / z along its ray: at most 1.255 x at this camera's image corners
