@@ -19,10 +19,10 @@ execute_process(COMMAND ${PYTHON} -c "
 import sonomap
 print(sonomap.__file__)
 scene = sonomap.Scenario('${SOURCE_DIR}/tests/python/wall.yaml')
-print(scene.name, len(scene), scene[0].depth[24, 32])
+print(scene.name, len(scene), '%.6f' % scene[0].depth[24, 32])
 " RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err WORKING_DIRECTORY ${WORK_DIR})
 string(STRIP "${out}" out)
-if(NOT rc EQUAL 0 OR NOT out MATCHES "^${prefix}/${SITE}/sonomap[^\n]*\\.so\nwall 2 2\\.0$")
+if(NOT rc EQUAL 0 OR NOT out MATCHES "^${prefix}/${SITE}/sonomap[^\n]*\\.so\nwall 2 2\\.000000$")
   message(FATAL_ERROR "importing the installed module: exit ${rc}\n${out}\n${err}")
 endif()
 file(REMOVE_RECURSE ${WORK_DIR})
