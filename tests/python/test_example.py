@@ -2,6 +2,7 @@
 """The docs' example (examples/python/wedge_mapper.py) runs and scores sensibly on the smoke
 scene: a Python mapper in the loop beside VDB-GPDF."""
 import importlib.util
+import inspect
 import os
 
 from testing import SOURCE_DIR, run
@@ -20,6 +21,13 @@ def test_wedge_mapper_beside_vdb_gpdf():
             # The camera sees 62.7 degrees, 0.174 of the circle: a working map covers at least
             # half of that. Surfaces are 0.5 to 3 m away; an RMSE of 0.3 m means a broken map.
             assert s["coverage"] > 0.087 and s["rmse"] < 0.3, (name, s)
+
+
+def test_docs_show_the_example_as_it_is():
+    with open(os.path.join(SOURCE_DIR, "docs", "python.md")) as f:
+        docs = f.read()
+    for function in (wedge_mapper.wedge_circle, wedge_mapper.main):
+        assert inspect.getsource(function) in docs, function.__name__
 
 
 run(globals())
