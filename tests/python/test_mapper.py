@@ -45,13 +45,14 @@ def test_depth_only_reads_the_walls():
     assert error.max() < 0.01, error.max()
 
 
-def test_vdb_gpdf_reads_the_walls_within_a_voxel():
-    circle = mapped_circle("vdb_gpdf", voxel=0.05, settings={"carving": False})
-    known = ~np.isnan(circle)
-    assert FOV_BINS // 2 < np.count_nonzero(known) <= FOV_BINS + 2
-    # Surface samples of a 5 cm map lie within half a voxel diagonal (4.3 cm) of the wall.
-    error = np.abs(circle[known] - TRUTH[known])
-    assert error.max() < 0.0433, error.max()
+def test_the_maps_read_the_walls_within_half_a_voxel_diagonal():
+    for name, settings in (("vdb_gpdf", {"carving": False}), ("tsdf", None), ("open3d", None)):
+        circle = mapped_circle(name, voxel=0.05, settings=settings)
+        known = ~np.isnan(circle)
+        assert FOV_BINS // 2 < np.count_nonzero(known) <= FOV_BINS + 2, name
+        # Surface samples of a 5 cm map lie within half a voxel diagonal (4.3 cm) of the wall.
+        error = np.abs(circle[known] - TRUTH[known])
+        assert error.max() < 0.0433, (name, error.max())
 
 
 def test_mapper_config_records_the_settings():
