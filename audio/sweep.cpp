@@ -266,7 +266,7 @@ std::vector<SweepEvent> SweepRenderer::schedule(const Circle& circle) const {
 SweepAudio SweepRenderer::render(const Circle& circle) { return render(schedule(circle)); }
 
 SweepAudio SweepRenderer::render(std::vector<SweepEvent> events) {
-  SweepAudio out = mix(std::move(events));
+  SweepAudio out = mix(std::move(events), period_samples());
   level(out);
   return out;
 }
@@ -288,7 +288,7 @@ void SweepRenderer::level(SweepAudio& out) {
     out.peak_limited = peak_limited(raw, rules);
   } else {
     if (!fixed_gain_known_) {
-      const SweepAudio loudest = mix(loudest_events());
+      const SweepAudio loudest = mix(loudest_events(), period_samples());
       const LoudnessMeasure m = measure_loudness(loudest.left, loudest.right, loudest.sample_rate);
       fixed_gain_db_ = loudness_gain_db(m, rules);
       fixed_peak_limited_ = peak_limited(m, rules);
@@ -303,13 +303,17 @@ void SweepRenderer::level(SweepAudio& out) {
   out.loudness = with_gain(raw, out.gain_db);
 }
 
-SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events) {
+size_t SweepRenderer::period_samples() const {
+  return static_cast<size_t>(std::ceil(config_.period_s * config_.sample_rate));
+}
+
+SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events, size_t min_length) {
   const BrirSet& set = brirs();
   const double fs = config_.sample_rate;
   // Indices of each event's BRIR and its first output sample.
   std::vector<std::pair<size_t, size_t>> pairs;
   std::vector<size_t> starts;
-  size_t length = static_cast<size_t>(std::ceil(config_.period_s * fs));
+  size_t length = min_length;
   for (const SweepEvent& e : events) {
     if (!(std::isfinite(e.time_s) && e.time_s >= 0.0 && e.time_s <= 600.0))
       throw std::invalid_argument("sweep: event time out of [0, 600] s");
@@ -341,11 +345,13 @@ SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events) {
   out.right.assign(length, 0.0f);
   for (size_t i = 0; i < events.size(); ++i) {
     const size_t n = convolver_.output_length(variant(events[i].sound, events[i].pitch_semitones).samples.size());
+    float peak = 0.0f;
     for (int ear = 0; ear < 2; ++ear) {
       float* dst = (ear == 0 ? out.left.data() : out.right.data()) + starts[i];
       const float* src = scratch_[2 * i + ear].data();
-      for (size_t k = 0; k < n; ++k) dst[k] += src[k];
+      for (size_t k = 0; k < n; ++k) dst[k] += src[k], peak = std::max(peak, std::abs(src[k]));
     }
+    events[i].peak_amplitude = peak;
   }
   out.events = std::move(events);
   return out;

@@ -85,6 +85,7 @@ struct SweepEvent {
   double brir_azimuth_deg = 0.0;  // the grid azimuth used
   double pitch_semitones = 0.0;
   SoundKind sound = SoundKind::Tap;
+  double peak_amplitude = 0.0;  // the event's own rendered sound, both ears, before any gain
 };
 
 struct SweepAudio {
@@ -131,6 +132,9 @@ class SweepRenderer {
   std::vector<SweepEvent> loudest_events() const;
   // The dry sound an event plays (tap pitch variants are made once, at construction).
   const std::vector<float>& sound(SoundKind kind, double semitones) const;
+  // The events mixed, before any gain: at least `min_length` samples, longer if the last sound
+  // rings on. Fills each event's peak_amplitude. A continuous stream mixes its pieces with this.
+  SweepAudio mix(std::vector<SweepEvent> events, size_t min_length);
   void clear_cache() { convolver_.clear_cache(); }
   size_t cached_spectra() const { return convolver_.cached_spectra(); }
 
@@ -141,7 +145,7 @@ class SweepRenderer {
   };
   const Variant& variant(SoundKind kind, double semitones) const;
   size_t longest_sound() const;
-  SweepAudio mix(std::vector<SweepEvent> events);  // before any gain
+  size_t period_samples() const;
   void level(SweepAudio& audio);
 
   double fixed_gain_db_ = 0.0;

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,20 @@ struct Keyframe {
 struct TrajectorySpec {
   Interpolation interpolation = Interpolation::LinearSlerp;
   std::vector<Keyframe> keyframes;  // strictly increasing times, at least one
+};
+
+// The listener's head, for rendering only: the sensor and the rasters stay on the body. Yaw
+// and pitch are linear in time between keyframes (no wrap: a keyframe yaw of 270 after 0 turns
+// three quarters left), held before the first and after the last.
+struct HeadKeyframe {
+  double time = 0.0;
+  double yaw_deg = 0.0;    // left positive
+  double pitch_deg = 0.0;  // positive tilts the face down (recorded; the sweep is horizontal)
+};
+struct HeadSpec {
+  bool absolute = false;  // yaw in the world; otherwise relative to the body's heading
+  std::vector<HeadKeyframe> keyframes;  // strictly increasing times, at least one
+  HeadKeyframe at(double t) const;      // the interpolated yaw and pitch at time t
 };
 
 // A shape in the scene before triangulation. Kept so that tests and ground truth can use
@@ -119,6 +134,7 @@ struct Scenario {
   NoiseSpec noise;
   LocalisationSpec localisation;
   TrajectorySpec body;  // world_T_body over time
+  std::optional<HeadSpec> head;  // none: the head follows the body
   int frames = 1;
   std::uint64_t seed = 1;
 };

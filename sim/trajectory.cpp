@@ -56,4 +56,16 @@ Eigen::Isometry3d pose_at(const TrajectorySpec& trajectory, double t) {
   return make_pose(position, orientation);
 }
 
+HeadKeyframe HeadSpec::at(double t) const {
+  if (keyframes.empty()) return {t, 0.0, 0.0};
+  if (t <= keyframes.front().time) return {t, keyframes.front().yaw_deg, keyframes.front().pitch_deg};
+  if (t >= keyframes.back().time) return {t, keyframes.back().yaw_deg, keyframes.back().pitch_deg};
+  const auto next = std::upper_bound(keyframes.begin(), keyframes.end(), t,
+                                     [](double time, const HeadKeyframe& k) { return time < k.time; });
+  const HeadKeyframe& a = *(next - 1);
+  const HeadKeyframe& b = *next;
+  const double w = (t - a.time) / (b.time - a.time);
+  return {t, a.yaw_deg + w * (b.yaw_deg - a.yaw_deg), a.pitch_deg + w * (b.pitch_deg - a.pitch_deg)};
+}
+
 }  // namespace sonomap::sim

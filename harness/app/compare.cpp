@@ -177,13 +177,15 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
   }
   SweepReader r(file);
   r.check_keys(root, "", {"name", "frames", "every", "seeds", "set", "scenarios", "variants",
-                          "pictures", "sweeps", "description", "claims", "gates"});
+                          "pictures", "sweeps", "listen", "description", "claims", "gates"});
   Sweep sweep;
   if (!root["name"]) r.fail(root, "name", "missing");
   sweep.name = r.identifier(root["name"], "name");
   const std::vector<std::string> common_set = r.strings(root["set"], "set");
   const std::vector<std::string> pictures = r.strings(root["pictures"], "pictures");
   const std::vector<std::string> sweeps = r.strings(root["sweeps"], "sweeps");
+  // listen: true -> each run writes listen.wav (same walk per scenario: A/B by ear).
+  const bool listen = root["listen"] && r.scalar<bool>(root["listen"], "listen");
   std::vector<std::uint64_t> seeds{1};
   if (root["seeds"]) {
     if (!root["seeds"].IsSequence() || root["seeds"].size() == 0) r.fail(root["seeds"], "seeds", "expected a non-empty list");
@@ -249,6 +251,7 @@ Sweep load_sweep(const fs::path& file, const fs::path& out) {
             if (!external || o.rfind("mapper.", 0) != 0) a.insert(a.end(), {"--set", o});
         append_frames_list(a, "--pictures", pictures);
         if (!external) append_frames_list(a, "--sweeps", sweeps);
+        if (listen && !external) a.push_back("--listen");
         sweep.jobs.push_back(std::move(job));
       }
     }

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/app/config_fields.hpp"
 
+#include "harness/app/run_settings.hpp"
+
 namespace sonomap::harness {
 
 FieldTable vdb_gpdf_fields(VdbGpdfConfig& c) {
@@ -99,6 +101,20 @@ FieldTable edf_raster_fields(EdfRasterConfig& c) {
       positive("hit_tolerance", &c.hit_tolerance, "m", 10.0, "a traced ray hits below this distance"),
       whole("max_steps", &c.max_steps, 1, 1000000, "sphere-tracing steps before a ray gives up"),
       positive("max_range", &c.max_range, "m", kMaxRange, "ray length (default: raster.max_range)"),
+  };
+}
+
+FieldTable listen_fields(ListenSettings& c) {
+  audio::ListenConfig& l = c.stream;
+  return {
+      number("period", &l.period_s, "s", 0.1, 60.0, "one sweep round the circle (run --listen)"),
+      number("pause", &l.pause_s, "s", 0.0, 60.0, "silence after each sweep"),
+      {"mode", Choice{{"world_locked", "head_locked"},
+                      [&l] { return l.mode == audio::ListenMode::WorldLocked ? 0 : 1; },
+                      [&l](int i) { l.mode = i == 0 ? audio::ListenMode::WorldLocked : audio::ListenMode::HeadLocked; }},
+       "", {}, "world_locked: obstacles stay put as the head turns; head_locked: they turn with it"},
+      number("rt60", &c.rt60, "s", 0.05, 3.0, "reverberation of the synthesised room (no --brir)"),
+      flag("woosh", &c.woosh, "unscanned sectors play the woosh"),
   };
 }
 

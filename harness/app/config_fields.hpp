@@ -20,5 +20,7 @@ FieldTable open3d_fields(Open3dTsdfConfig& c);
 FieldTable raster_fields(RasterConfig& c);
 FieldTable metrics_fields(eval::MetricsConfig& c);
 FieldTable edf_raster_fields(EdfRasterConfig& c);
+struct ListenSettings;
+FieldTable listen_fields(ListenSettings& c);
 
 }  // namespace sonomap::harness

@@ -31,6 +31,7 @@ class SimulatedSource final : public FrameSource {
     return {simulation_->render(i), world_T_body_true};
   }
   double ground_z() const override { return scenario_.ground_z; }
+  std::optional<sim::HeadSpec> head() const override { return scenario_.head; }
   std::uint64_t seed() const override { return scenario_.seed; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
     return sim::world_triangles(scenario_, t);

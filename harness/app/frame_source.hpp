@@ -35,6 +35,8 @@ class FrameSource {
   virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
   // The files and folders it reads (no output may be, contain or lie inside one).
   virtual std::vector<std::filesystem::path> inputs() const = 0;
+  // The listener's head when the scenario moves it apart from the body (rendering only).
+  virtual std::optional<sim::HeadSpec> head() const { return std::nullopt; }
 };
 
 // A scenario's files: the YAML itself and the meshes it names.

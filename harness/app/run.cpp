@@ -6,6 +6,7 @@
 #include "core/stopwatch.hpp"
 #include "eval/evaluate_frame.hpp"
 #include "harness/app/frame_outputs.hpp"
+#include "harness/app/listen_step.hpp"
 #include "harness/app/run_results.hpp"
 #include "harness/app/run_setup.hpp"
 #include "harness/app/sonify.hpp"
@@ -90,6 +91,8 @@ RunOutcome run_scenario(const RunOptions& options) {
   RunResults results(staged.path(), options.write_rasters);
   FrameOutputs outputs(staged.path(), options, schedule, source.name(), mapper->name(),
                        inputs.settings.raster);
+  std::optional<ListenStep> listen;  // --listen: listen.wav, the stream over the whole run
+  if (options.listen) listen.emplace(staged.path(), options, inputs.settings.listen, source.head());
   Rasteriser rasteriser(inputs.settings.raster);
   std::vector<Eigen::Vector3f> surface;
   Progress progress("run " + source.name(), schedule.frame_count(), options.quiet);
@@ -108,6 +111,7 @@ RunOutcome run_scenario(const RunOptions& options) {
                            &rasteriser.cylinder(), &surface, &evaluation};
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
       outputs.write(view);
+      if (listen) listen->add(view);
     }
     results.add_timings(i, times);
     progress.update(i + 1);
@@ -117,6 +121,7 @@ RunOutcome run_scenario(const RunOptions& options) {
   RunSummary summary = describe_run(options, inputs, *mapper);
   results.fill_metrics(summary, inputs.settings.edf_enabled);
   summary.sweeps = outputs.sweep_levels();
+  if (listen) summary.listen = listen->finish(schedule.frame_count());
   results.finish(summary, *mapper);
   staged.commit();
   return RunOutcome{options.out, summary};
@@ -187,6 +192,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "Frames to sonify as a WAV sweep (default: the last; -1: none)");
   cmd->add_option("--brir", options->brir_dir,
                   "BRIR directory for the sweeps (default: synthesise the room from the map)");
+  cmd->add_flag("--listen", options->listen,
+                "Write listen.wav: the binaural stream a wearer hears over the whole run, sweeps "
+                "every listen.period (docs/sonification.md)");
   cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
   cmd->footer(run_keys_help());

@@ -38,6 +38,7 @@ struct RunOptions {
   // from the map").
   std::filesystem::path brir_dir;
   bool write_rasters = true;
+  bool listen = false;  // listen.wav and listen_events.csv (harness/app/listen_step.hpp)
   bool quiet = false;
   // "key=value" labels recorded in summary.json (compare uses scenario=..., variant=...).
   std::vector<std::string> tags;

@@ -16,7 +16,7 @@ namespace sonomap::harness {
 namespace {
 
 bool is_run_key(const std::string& key) {
-  for (const char* prefix : {"mapper.", "raster.", "metrics.", "edf."})
+  for (const char* prefix : {"mapper.", "raster.", "metrics.", "edf.", "listen."})
     if (key.rfind(prefix, 0) == 0) return true;
   return false;
 }
@@ -76,7 +76,8 @@ std::vector<FieldGroup> run_key_fields(RunSettings& s) {
       whole("trace_rows", &s.edf_trace_rows, 0, 100,
             "rays per bin across the obstacle band (0: one at the sensor's height)")};
   for (Field& f : edf_raster_fields(s.edf)) edf.push_back(std::move(f));
-  return {{"raster.", raster_fields(s.raster)}, {"metrics.", metrics_fields(s.metrics)}, {"edf.", edf}};
+  return {{"raster.", raster_fields(s.raster)}, {"metrics.", metrics_fields(s.metrics)}, {"edf.", edf},
+          {"listen.", listen_fields(s.listen)}};
 }
 
 void split_overrides(const std::vector<std::string>& overrides, std::vector<std::string>& scenario,

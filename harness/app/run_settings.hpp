@@ -4,6 +4,7 @@
 // field tables (harness/app/config_fields.hpp); docs/settings.md lists them.
 #pragma once
 
+#include "audio/listen_stream.hpp"
 #include "core/edf_raster.hpp"
 #include "core/raster.hpp"
 #include "eval/metrics.hpp"
@@ -18,6 +19,13 @@
 
 namespace sonomap::harness {
 
+// The binaural stream of `run --listen` (docs/sonification.md).
+struct ListenSettings {
+  audio::ListenConfig stream;
+  double rt60 = 0.5;        // the synthesised room's reverberation (no --brir)
+  bool woosh = true;        // unscanned sectors play the woosh
+};
+
 // Run keys (everything that is not part of the scenario file).
 struct RunSettings {
   RasterConfig raster;
@@ -31,6 +39,7 @@ struct RunSettings {
   int edf_trace_rows = 4;  // rays per bin across the obstacle band (0: the sensor's height)
   EdfRasterConfig edf;
   bool edf_max_range_set = false;  // otherwise the raster's max_range
+  ListenSettings listen;  // the stream of `run --listen` (listen.*)
 };
 
 // The run keys of `settings` by group ("raster.", "metrics.", "edf."), bound to its members.

@@ -216,6 +216,15 @@ void to_json(json& j, const RunSummary& s) {
   for (const SweepLevel& l : s.sweeps)
     j["sweeps"].push_back({{"file", l.file}, {"gain_db", l.gain_db}, {"loudness_lufs", l.loudness_lufs},
                            {"true_peak_dbtp", l.true_peak_dbtp}, {"peak_limited", l.peak_limited}});
+  if (s.listen) {
+    const ListenSummary& l = *s.listen;
+    j["listen"] = {{"file", l.file}, {"mode", l.mode}, {"duration_s", l.duration_s},
+                   {"taps", l.taps}, {"gain_db", l.gain_db}, {"loudness_lufs", l.loudness_lufs},
+                   {"true_peak_dbtp", l.true_peak_dbtp}, {"peak_limited", l.peak_limited},
+                   {"localisation", {{"taps", l.localised_taps},
+                                     {"median_error_deg", l.median_error_deg},
+                                     {"p90_error_deg", l.p90_error_deg}}}};
+  }
 }
 
 void from_json(const json& j, RunSummary& s) {
@@ -242,6 +251,16 @@ void from_json(const json& j, RunSummary& s) {
     s.sweeps.push_back({l.at("file").get<std::string>(), l.at("gain_db").get<double>(),
                         number_of(l.at("loudness_lufs")), number_of(l.at("true_peak_dbtp")),
                         l.at("peak_limited").get<bool>()});
+  if (j.contains("listen")) {
+    const json& l = j.at("listen");
+    const json& where = l.at("localisation");
+    s.listen = ListenSummary{l.at("file").get<std::string>(), l.at("mode").get<std::string>(),
+                             l.at("duration_s").get<double>(), l.at("taps").get<int>(),
+                             l.at("gain_db").get<double>(), number_of(l.at("loudness_lufs")),
+                             number_of(l.at("true_peak_dbtp")), l.at("peak_limited").get<bool>(),
+                             where.at("taps").get<int>(), number_of(where.at("median_error_deg")),
+                             number_of(where.at("p90_error_deg"))};
+  }
 }
 
 void to_json(json& j, const StageTiming& t) {

@@ -72,6 +72,19 @@ struct SweepLevel {
   bool peak_limited = false;
 };
 
+// The binaural stream of `run --listen` (summary.json "listen"): its one gain, its measured
+// loudness, and how well each tap's direction survives the mix (localise_taps).
+struct ListenSummary {
+  std::string file;  // listen.wav
+  std::string mode;  // world_locked | head_locked
+  double duration_s = 0.0;
+  int taps = 0;  // sounds played (taps and wooshes)
+  double gain_db = 0.0, loudness_lufs = 0.0, true_peak_dbtp = 0.0;
+  bool peak_limited = false;
+  int localised_taps = 0;  // taps whose direction was estimated
+  double median_error_deg = 0.0, p90_error_deg = 0.0;  // NaN without taps
+};
+
 struct RunSummary {
   int schema_version = kResultSchemaVersion;
   std::string scenario_name;
@@ -86,6 +99,7 @@ struct RunSummary {
   std::optional<RasterSummary> edf_circle;  // with the EDF comparison on
   std::optional<EdfSummary> edf;            // with the EDF comparison on
   std::vector<SweepLevel> sweeps;
+  std::optional<ListenSummary> listen;
 };
 
 // timings.json: per stage, the median wall time over the frames it ran in.

@@ -276,6 +276,31 @@ sim::Interpolation read_interpolation(const MapReader& map) {
   map.fail("interpolation", "unknown interpolation '" + name + "' (known: linear_slerp)");
 }
 
+// The listener's head: yaw/pitch keyframes, relative to the body (default) or to the world.
+sim::HeadSpec read_head(const Context& ctx, const YAML::Node& node) {
+  const MapReader map(ctx, node, "head", {"relative_to", "keyframes"});
+  sim::HeadSpec head;
+  const std::string frame = map.text("relative_to", "body");
+  if (frame != "body" && frame != "world")
+    map.fail("relative_to", "expected body or world, got '" + frame + "'");
+  head.absolute = frame == "world";
+  const YAML::Node frames = require_sequence(ctx, map.required("keyframes"), "head.keyframes");
+  if (frames.size() == 0) ctx.fail(frames, "head.keyframes", "the head has no keyframes");
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::string k = item_key("head.keyframes", i);
+    ctx.attempt([&] {
+      const MapReader kf(ctx, frames[i], k, {"time", "yaw", "pitch"});
+      const sim::HeadKeyframe keyframe{kf.number("time"), kf.number("yaw", 0.0), kf.number("pitch", 0.0)};
+      if (std::abs(keyframe.pitch_deg) > 90.0) kf.fail("pitch", "head pitch must be in [-90, 90] degrees");
+      if (!head.keyframes.empty() && !(keyframe.time > head.keyframes.back().time))
+        kf.fail("time", "keyframe times must increase: " + std::to_string(keyframe.time) +
+                            " s is not after " + std::to_string(head.keyframes.back().time) + " s");
+      head.keyframes.push_back(keyframe);
+    });
+  }
+  return head;
+}
+
 sim::TrajectorySpec read_trajectory(const Context& ctx, const YAML::Node& node,
                                     const std::string& key) {
   const MapReader map(ctx, node, key, {"interpolation", "keyframes"});
@@ -656,7 +681,7 @@ sim::Scenario load_scenario(const fs::path& file, const std::vector<std::string>
 
   const MapReader top(ctx, root, "",
                       {"name", "seed", "frames", "duration", "ground_z", "sensor", "localisation",
-                       "body", "static", "moving"});
+                       "body", "head", "static", "moving"});
   sim::Scenario scenario;
   scenario.source_path = name;
   scenario.name = top.text("name", file.stem().string());
@@ -671,6 +696,7 @@ sim::Scenario load_scenario(const fs::path& file, const std::vector<std::string>
     ctx.attempt([&] { read_localisation(ctx, root["localisation"], scenario.localisation); });
   ctx.attempt([&] { scenario.frames = read_frame_count(top, scenario.camera.rate_hz); });
   ctx.attempt([&] { scenario.body = read_trajectory(ctx, top.required("body"), "body"); });
+  if (top.has("head")) ctx.attempt([&] { scenario.head = read_head(ctx, root["head"]); });
   if (top.has("static")) ctx.attempt([&] { scenario.statics = read_statics(ctx, root["static"]); });
   if (top.has("moving")) ctx.attempt([&] { scenario.movers = read_movers(ctx, root["moving"]); });
   ctx.attempt([&] { check_unique_names(ctx, root, scenario); });

@@ -160,6 +160,31 @@ TEST_CASE("overrides change the document before validation", "[scenario]") {
   CHECK(x_axis.isApprox(Eigen::Vector3d(1, 1, 0).normalized(), 1e-12));
 }
 
+TEST_CASE("head: yaw and pitch keyframes relative to the body or the world, linear in time",
+          "[scenario][head]") {
+  ScratchDir dir("scenario");
+  CHECK_FALSE(load_scenario(dir.write("probe.yaml", kBase)).head);  // follows the body
+  const auto s = load_scenario(dir.write(
+      "head.yaml", kBase + "head:\n  keyframes:\n    - {time: 1, yaw: 0}\n"
+                           "    - {time: 3, yaw: 270, pitch: -10}\n"));
+  REQUIRE(s.head);
+  CHECK_FALSE(s.head->absolute);
+  CHECK(s.head->at(0.0).yaw_deg == 0.0);    // held before the first keyframe
+  CHECK(s.head->at(2.0).yaw_deg == 135.0);  // no wrap: three quarters of a turn left
+  CHECK(s.head->at(2.0).pitch_deg == -5.0);
+  CHECK(s.head->at(9.0).yaw_deg == 270.0);
+  const auto w = load_scenario(dir.write(
+      "world.yaml", kBase + "head:\n  relative_to: world\n  keyframes:\n    - {time: 0, yaw: 45}\n"));
+  CHECK(w.head->absolute);
+  const std::string file = (dir.path() / "probe.yaml").string();
+  check_located(error_for(dir, kBase + "head:\n  relative_to: neck\n  keyframes: [{time: 0}]\n"),
+                file, 16, "head.relative_to");
+  check_located(error_for(dir, kBase + "head:\n  keyframes:\n    - {time: 0, pitch: 95}\n"), file,
+                17, "head.keyframes[0].pitch");
+  check_located(error_for(dir, kBase + "head:\n  keyframes:\n    - {time: 2}\n    - {time: 1}\n"),
+                file, 18, "head.keyframes[1].time");
+}
+
 TEST_CASE("bad input: each error names the file, the line and the key", "[scenario][bad-input]") {
   ScratchDir dir("scenario");
   const std::string file = (dir.path() / "probe.yaml").string();
