@@ -185,7 +185,7 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                   "refused (0: half the RAM)")
       ->check(CLI::Range(0.0, 1e6))->capture_default_str();
   cmd->add_option("--set", options->overrides,
-                  "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*, edf.*)");
+                  "key=value: override a scenario key or a run key (mapper.*, raster.*, metrics.*, edf.*, listen.*)");
   cmd->add_option("--pictures", options->picture_frames,
                   "Frames to draw (default: the last; -1: none)");
   cmd->add_option("--sweeps", options->sweep_frames,

@@ -22,7 +22,7 @@ namespace sonomap::harness {
 // The binaural stream of `run --listen` (docs/sonification.md).
 struct ListenSettings {
   audio::ListenConfig stream;
-  double rt60 = 0.5;        // the synthesised room's reverberation (no --brir)
+  double rt60 = 0.3;        // the synthesised room's reverberation (no --brir): docs/sonification.md
   bool woosh = true;        // unscanned sectors play the woosh
 };
 
