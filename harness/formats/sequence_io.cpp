@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/formats/sequence_io.hpp"
 
+#include "core/ground_plane.hpp"
+#include "harness/formats/mesh_io.hpp"
 #include "harness/formats/rosbag_io.hpp"
 #include "harness/formats/tum_io.hpp"
 #include "harness/support/errors.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <fstream>
 #include <sstream>
 #include <system_error>
@@ -173,6 +177,7 @@ RecordedSequence::RecordedSequence(SequenceSpec spec, std::unique_ptr<RecordRead
   if (reader_->count() < 1) throw InputError(spec_.file.string(), 0, "", "the recording has no frame");
   const DepthRecord first = reader_->read(0);
   time_zero_ = first.time;
+  depth_images_ = !first.depth.empty();
   const double median = median_depth(first);
   if (median < kPlausibleMedianMin || median > kPlausibleMedianMax)
     throw InputError(spec_.file.string(), 0, "sequence.depth.scale",
@@ -180,8 +185,57 @@ RecordedSequence::RecordedSequence(SequenceSpec spec, std::unique_ptr<RecordRead
                          " m is not plausible for an RGB-D camera; check depth.scale (units per "
                          "metre: millimetres 1000, TUM 5000) and depth.encoding");
   ground_z_ = spec_.floor.value_or(0.0);
+  if (spec_.auto_floor) detect_floor(first);
   if (spec_.listener_height)
     ground_z_ = aligned(0, first).world_T_body.translation().z() - *spec_.listener_height;
+  load_truth();
+}
+
+// The floor plane among the first frames' points, found in a frame turned so that the guessed
+// up (the given axis, or the first camera's up: optical -y) is z; its normal becomes +z.
+void RecordedSequence::detect_floor(const DepthRecord& first) {
+  const Eigen::Vector3d guess =
+      spec_.up_given ? spec_.up : -(first.world_T_camera * spec_.pose_T_camera).linear().col(1);
+  const Eigen::Quaterniond guess_to_z = Eigen::Quaterniond::FromTwoVectors(guess, Eigen::Vector3d::UnitZ());
+  const int frames = std::min(reader_->count(), spec_.floor_frames);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < frames; ++i) {
+    DepthRecord record = i == 0 ? first : reader_->read(i);
+    record.world_T_camera = record.world_T_camera * spec_.pose_T_camera;
+    const Frame frame = frame_from_record(i, record, 0.0, reader_->camera());
+    const std::size_t stride = 1 + frame.points_camera.size() / 20000;  // enough for a plane
+    for (std::size_t k = 0; k < frame.points_camera.size(); k += stride)
+      points.push_back((guess_to_z * (frame.world_T_camera * frame.points_camera[k].cast<double>())).cast<float>());
+  }
+  GroundPlane plane;
+  try {
+    plane = estimate_ground_plane(points);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(spec_.file.string(), 0, "sequence.world.floor",
+                     "auto: no floor plane within 30 degrees of the guessed up axis in the first " +
+                         std::to_string(frames) + " frames (" + e.what() + "); give world.up and world.floor");
+  }
+  const Eigen::Vector3d normal = guess_to_z.inverse() * plane.normal;
+  up_T_world_ = Eigen::Isometry3d::Identity();
+  up_T_world_.linear() = Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  ground_z_ = -plane.offset;  // normal . p + offset = 0, the normal turned onto z
+}
+
+void RecordedSequence::load_truth() {
+  if (spec_.truth_file.empty()) return;
+  const Eigen::Isometry3d up_T_truth = up_T_world_ * spec_.world_T_truth;
+  if (!spec_.truth_is_mesh) {
+    truth_cloud_ = load_point_cloud(spec_.truth_file);
+    for (Eigen::Vector3f& p : *truth_cloud_) p = (up_T_truth * p.cast<double>()).cast<float>();
+    return;
+  }
+  const sim::TriangleMesh mesh = load_mesh(spec_.truth_file);
+  truth_mesh_.emplace();
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    sim::WorldTriangle w;
+    for (int c = 0; c < 3; ++c) w[c] = up_T_truth * mesh.vertices[t[c]].cast<double>();
+    truth_mesh_->push_back(w);
+  }
 }
 
 Frame RecordedSequence::aligned(int i, const DepthRecord& record) const {
