@@ -191,34 +191,66 @@ RecordedSequence::RecordedSequence(SequenceSpec spec, std::unique_ptr<RecordRead
   load_truth();
 }
 
-// The floor plane among the first frames' points, found in a frame turned so that the guessed
-// up (the given axis, or the first camera's up: optical -y) is z; its normal becomes +z.
+namespace {
+
+// The floor plane among the first frames' points (in the recording's world), found in a frame
+// turned so that the guessed up is z, then again among the points at or below the plane found,
+// turned by its normal, until no more than 1 % of the points lie 5 cm below it: a first pass may
+// pick a table top or the top of a box, or lean on the walls' feet when the guess is tilted.
+Eigen::Vector3d floor_normal(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d up, double& offset) {
+  GroundPlaneConfig config;
+  std::vector<Eigen::Vector3d> candidates = points;
+  for (int pass = 0; pass < 8; ++pass) {
+    const Eigen::Quaterniond to_z = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ());
+    std::vector<Eigen::Vector3f> turned;
+    turned.reserve(candidates.size());
+    for (const Eigen::Vector3d& p : candidates) turned.push_back((to_z * p).cast<float>());
+    const GroundPlane plane = estimate_ground_plane(turned, config);
+    const bool moved = pass == 0 || std::abs(plane.offset - offset) > 0.01;  // the floor went down
+    up = to_z.inverse() * plane.normal;
+    offset = plane.offset;
+    std::size_t below = 0;
+    candidates.clear();
+    for (const Eigen::Vector3d& p : points) {
+      const double height = up.dot(p) + offset;
+      below += height < -0.05;
+      if (height < 0.05) candidates.push_back(p);
+    }
+    if (!moved && below <= points.size() / 100) break;
+    config.max_tilt_deg = 10.0;  // from the second pass on, the guess is close
+  }
+  return up;
+}
+
+}  // namespace
+
+// Sets the up axis and the floor from the floor plane of the first floor_frames frames; the
+// first guess is the given up axis, or the first camera's up (optical -y).
 void RecordedSequence::detect_floor(const DepthRecord& first) {
   const Eigen::Vector3d guess =
       spec_.up_given ? spec_.up : -(first.world_T_camera * spec_.pose_T_camera).linear().col(1);
-  const Eigen::Quaterniond guess_to_z = Eigen::Quaterniond::FromTwoVectors(guess, Eigen::Vector3d::UnitZ());
   const int frames = std::min(reader_->count(), spec_.floor_frames);
-  std::vector<Eigen::Vector3f> points;
+  std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < frames; ++i) {
     DepthRecord record = i == 0 ? first : reader_->read(i);
     record.world_T_camera = record.world_T_camera * spec_.pose_T_camera;
     const Frame frame = frame_from_record(i, record, 0.0, reader_->camera());
     const std::size_t stride = 1 + frame.points_camera.size() / 20000;  // enough for a plane
     for (std::size_t k = 0; k < frame.points_camera.size(); k += stride)
-      points.push_back((guess_to_z * (frame.world_T_camera * frame.points_camera[k].cast<double>())).cast<float>());
+      points.push_back(frame.world_T_camera * frame.points_camera[k].cast<double>());
   }
-  GroundPlane plane;
+  double offset = 0.0;
+  Eigen::Vector3d normal;
   try {
-    plane = estimate_ground_plane(points);
+    normal = floor_normal(points, guess, offset);
   } catch (const std::invalid_argument& e) {
     throw InputError(spec_.file.string(), 0, "sequence.world.floor",
                      "auto: no floor plane within 30 degrees of the guessed up axis in the first " +
                          std::to_string(frames) + " frames (" + e.what() + "); give world.up and world.floor");
   }
-  const Eigen::Vector3d normal = guess_to_z.inverse() * plane.normal;
   up_T_world_ = Eigen::Isometry3d::Identity();
   up_T_world_.linear() = Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  ground_z_ = -plane.offset;  // normal . p + offset = 0, the normal turned onto z
+  ground_z_ = -offset;  // normal . p + offset = 0, the normal turned onto z
 }
 
 void RecordedSequence::load_truth() {

@@ -59,7 +59,7 @@ test::CliResult run_cli(const fs::path& sequence, const fs::path& out) {
 void render_smoke_bag(const fs::path& out) {
   std::vector<std::string> render = {"--quiet", "render", test::shipped("scenes/smoke.yaml").string(), "--format",
                                      "rosbag", "--out", out.string(), "--frames", "6", "--truth-spacing", "0.05"};
-  for (const auto& key : test::small_camera()) render.insert(render.end(), {"--set", key});
+  for (const auto& key : test::small_camera_keys()) render.insert(render.end(), {"--set", key});
   const auto result = test::run_sonomap(render);
   INFO(result.output);
   REQUIRE(result.status == 0);
@@ -86,7 +86,7 @@ TEST_CASE("a scenario rendered as a ROS1 bag runs from its sequence file like th
   CHECK(types["/tf"] == "tf2_msgs/TFMessage");
 
   const auto direct = test::run_quietly(test::shipped("scenes/smoke.yaml"), scratch.path() / "direct",
-                                        test::small_camera());
+                                        test::small_camera_keys());
   const auto bagged = test::run_quietly(scratch.path() / "bag/sequence.yaml", scratch.path() / "bagged");
   CHECK(bagged["ground_truth"] == true);  // truth.ply beside the bag
   // The cloud holds the simulator's float32 depths as z; the points are recomputed from them,
