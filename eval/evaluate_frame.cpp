@@ -2,6 +2,7 @@
 #include "eval/evaluate_frame.hpp"
 
 #include "core/stopwatch.hpp"
+#include "eval/cloud_truth.hpp"
 
 #include <cmath>
 
@@ -38,7 +39,8 @@ FrameEvaluation evaluate_frame(const Circle& circle, const Cylinder& cylinder,
   out.has_truth = truth.has_value();
   if (truth) {
     const auto t0 = StageClock::now();
-    out.truth = ground_truth_rasters(*truth->triangles, truth->origin, config.raster);
+    out.truth = truth->cloud ? cloud_truth_rasters(*truth->cloud, truth->origin, config.raster)
+                             : ground_truth_rasters(*truth->triangles, truth->origin, config.raster);
     out.times.emplace_back("truth", ms_since(t0));
     out.circle = compare(circle, out.truth.circle, config.metrics);
     out.cylinder = compare(cylinder, out.truth.cylinder, config.metrics);

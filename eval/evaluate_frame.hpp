@@ -19,10 +19,12 @@
 
 namespace sonomap::eval {
 
-// The scene at the frame's instant, seen from the TRUE body pose (never the estimate).
+// The scene at the frame's instant, seen from the TRUE body pose (never the estimate): its
+// exact triangles, or a reference point cloud (eval/cloud_truth.hpp) when `cloud` is set.
 struct FrameTruth {
   const std::vector<GroundTruthTriangle>* triangles = nullptr;
   RasterOrigin origin;
+  const std::vector<Eigen::Vector3f>* cloud = nullptr;
 };
 
 struct EvaluationConfig {

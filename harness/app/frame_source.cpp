@@ -45,7 +45,8 @@ class SimulatedSource final : public FrameSource {
 };
 
 // A recording (a TUM RGB-D folder or a sequence file): its poses are what a localisation
-// system gave, its world turned z-up with the floor where the sequence file puts it.
+// system gave, its world turned z-up with the floor where the sequence file puts it; its truth
+// the sequence file's reference cloud or mesh, if any.
 class RecordedSource final : public FrameSource {
  public:
   RecordedSource(const fs::path& input, int frames)
@@ -63,7 +64,20 @@ class RecordedSource final : public FrameSource {
   }
   double ground_z() const override { return sequence_->ground_z(); }
   std::uint64_t seed() const override { return 0; }
-  std::optional<std::vector<sim::WorldTriangle>> truth(double) const override { return std::nullopt; }
+  // The sequence file's reference (static), if it names one.
+  std::optional<std::vector<sim::WorldTriangle>> truth(double) const override {
+    if (const auto* mesh = sequence_->truth_mesh()) return *mesh;
+    return std::nullopt;
+  }
+  const std::vector<Eigen::Vector3f>* truth_cloud() const override { return sequence_->truth_cloud(); }
+  bool depth_images() const override { return sequence_->depth_images(); }
+  std::string truth_note() const override {
+    if (sequence_->truth_cloud())
+      return "recorded data: minima over the reference cloud's points (truth.cloud; within its point "
+             "spacing of exact wedge minima, docs/conventions.md)";
+    if (sequence_->truth_mesh()) return "recorded data: exact wedge minima from the reference mesh (truth.mesh)";
+    return {};
+  }
   std::vector<fs::path> inputs() const override { return {input_}; }
 
  private:

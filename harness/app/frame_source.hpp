@@ -33,6 +33,13 @@ class FrameSource {
   virtual std::uint64_t seed() const = 0;
   // World triangles at time t, or nullopt when there is no ground truth (recorded data).
   virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
+  // A reference point cloud of a static scene (a recording's truth.cloud), or null: the truth
+  // is then the minimum over its points in each cell (eval/cloud_truth.hpp).
+  virtual const std::vector<Eigen::Vector3f>* truth_cloud() const { return nullptr; }
+  // Where a recording's truth comes from (summary.json ground_truth_note); empty: the default.
+  virtual std::string truth_note() const { return {}; }
+  // False when the frames carry points but no depth image (an unorganised point cloud).
+  virtual bool depth_images() const { return true; }
   // The files and folders it reads (no output may be, contain or lie inside one).
   virtual std::vector<std::filesystem::path> inputs() const = 0;
   // The listener's head when the scenario moves it apart from the body (rendering only).

@@ -59,14 +59,17 @@ void rasterise(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& ras
   times.emplace_back("raster", ms_since(t0));
 }
 
-// Truth from the scene at the frame's time seen from the true pose (none for recorded data).
+// Truth from the scene at the frame's time seen from the true pose (for recorded data: its
+// reference cloud or mesh, if the sequence file names one).
 eval::FrameEvaluation evaluate(const RunInputs& inputs, const Mapper& mapper,
                                const SourceFrame& sensed, const Rasteriser& rasteriser,
                                bool with_edf, FrameTimes& times) {
   const auto triangles = inputs.source->truth(sensed.frame.time);
+  const auto* cloud = inputs.source->truth_cloud();
   std::optional<eval::FrameTruth> truth;
-  if (triangles)
-    truth = eval::FrameTruth{&*triangles, raster_origin(sensed.world_T_body_true, inputs.source->ground_z())};
+  if (triangles || cloud)
+    truth = eval::FrameTruth{triangles ? &*triangles : nullptr,
+                             raster_origin(sensed.world_T_body_true, inputs.source->ground_z()), cloud};
   const RunSettings& s = inputs.settings;
   eval::FrameEvaluation evaluation = at_frame(sensed.frame, [&] {
     return eval::evaluate_frame(rasteriser.circle(), rasteriser.cylinder(), truth,

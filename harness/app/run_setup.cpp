@@ -18,7 +18,7 @@ RunInputs load_run_inputs(const RunOptions& options) {
   split_overrides(options.overrides, scenario_overrides, inputs.settings);
   inputs.source = open_frame_source(options.scenario, std::move(scenario_overrides),
                                     options.frames, options.seed);
-  inputs.has_truth = inputs.source->truth(0.0).has_value();
+  inputs.has_truth = inputs.source->truth(0.0).has_value() || inputs.source->truth_cloud() != nullptr;
   return inputs;
 }
 
@@ -28,6 +28,11 @@ std::unique_ptr<Mapper> build_mapper(const RunOptions& options, RunInputs& input
   // docs/conventions.md: a ghost is more than 2 voxels closer than the truth.
   if (!settings.ghost_tolerance_set && mapper_voxel(*mapper) > 0.0)
     settings.metrics.ghost_tolerance = 2.0 * mapper_voxel(*mapper);
+  // The Open3D peer fuses frame.depth (the image), not the points.
+  if (mapper->name() == "open3d" && !inputs.source->depth_images())
+    throw InputError(options.scenario.string() + ": mapper " + mapper->name() +
+                     " fuses depth images, but the depth topic holds unorganised point clouds (height 1): "
+                     "record an organised cloud (one point per pixel) or a depth image, or use another mapper");
   check_memory_budget(*mapper, *inputs.source, options.max_memory_gib);
   return mapper;
 }
@@ -41,6 +46,7 @@ RunSummary describe_run(const RunOptions& options, const RunInputs& inputs, cons
   s.seed = source.seed();
   s.code_version = code_version();
   s.ground_truth = inputs.has_truth;
+  s.ground_truth_note = source.truth_note();
   s.tags = inputs.tags;
   RunConfig& c = s.config;
   c.mapper = mapper.name();

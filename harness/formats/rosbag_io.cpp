@@ -9,8 +9,11 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -158,7 +161,7 @@ class BagReader final : public RecordReader {
     camera_ = spec.camera_info_topic.empty() ? spec.camera
                                              : camera_from_info(bag_, spec.camera_info_topic, spec.camera);
     poses_ = read_poses(bag_, spec.pose_topic);
-    bag_.require(spec.depth_topic, {"sensor_msgs/Image"});
+    bag_.require(spec.depth_topic, {cloud() ? "sensor_msgs/PointCloud2" : "sensor_msgs/Image"});
     view_ = std::make_unique<rosbag::View>(bag_.bag(), rosbag::TopicQuery(spec.depth_topic));
     count_ = static_cast<int>(view_->size());
     rewind();
@@ -168,10 +171,9 @@ class BagReader final : public RecordReader {
   DepthRecord read(int i) override {
     if (i < next_) rewind();
     for (; next_ < i; ++next_) ++it_;  // skipped messages are not deserialised
-    const auto image = bag_.instantiate<sensor_msgs::Image>(*it_, i);
-    if (!image) bag_.fail(spec_.depth_topic, i, "is a " + it_->getDataType() + "; expected sensor_msgs/Image");
+    DepthRecord record = cloud() ? decode_cloud(message<sensor_msgs::PointCloud2>(i), i)
+                                 : decode(message<sensor_msgs::Image>(i), i);
     ++it_, ++next_;
-    DepthRecord record = decode(*image, i);
     if (i > 0 && record.time < last_stamp_)
       bag_.fail(spec_.depth_topic, i, "header stamp " + std::to_string(record.time) +
                                           " is before the previous one: stamps must be in order");
@@ -186,6 +188,14 @@ class BagReader final : public RecordReader {
   }
 
  private:
+  bool cloud() const { return spec_.encoding == DepthEncoding::PointCloud2; }
+  template <typename T>
+  const T& message(int i) {
+    current_ = bag_.instantiate<T>(*it_, i);
+    if (!current_) bag_.fail(spec_.depth_topic, i, "is a " + it_->getDataType() + "; expected " +
+                                                       ros::message_traits::datatype<T>());
+    return *boost::static_pointer_cast<T>(current_);
+  }
   void rewind() {
     it_ = view_->begin();
     next_ = 0;
@@ -217,6 +227,52 @@ class BagReader final : public RecordReader {
     }
     return record;
   }
+  // Float32 x, y, z in the camera optical frame: the cloud's finite points, and for an organised
+  // cloud (the camera's rows) the depth image of their z as well.
+  DepthRecord decode_cloud(const sensor_msgs::PointCloud2& cloud, int i) const {
+    std::array<int, 3> offset{-1, -1, -1};
+    for (const sensor_msgs::PointField& f : cloud.fields)
+      for (int axis = 0; axis < 3; ++axis)
+        if (f.name == std::string(1, static_cast<char>('x' + axis)) && f.datatype == sensor_msgs::PointField::FLOAT32)
+          offset[axis] = static_cast<int>(f.offset);
+    const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
+    const bool fits = *std::min_element(offset.begin(), offset.end()) >= 0 &&
+                      *std::max_element(offset.begin(), offset.end()) + 4 <= static_cast<int>(cloud.point_step) &&
+                      cloud.row_step >= cloud.width * cloud.point_step &&
+                      cloud.data.size() >= static_cast<std::size_t>(cloud.row_step) * cloud.height;
+    if (cloud.is_bigendian || !fits)
+      bag_.fail(spec_.depth_topic, i, "expected a little-endian cloud with float32 fields x, y, z inside "
+                                      "point_step and data of row_step x height bytes");
+    const auto at = [&](std::size_t row, std::size_t col, int axis) {
+      float v = 0.0f;
+      std::memcpy(&v, &cloud.data[row * cloud.row_step + col * cloud.point_step + offset[axis]], 4);
+      return v;
+    };
+    DepthRecord record;
+    record.time = cloud.header.stamp.toSec();
+    if (cloud.height <= 1) {
+      for (std::size_t k = 0; k < points; ++k) {
+        const Eigen::Vector3f p(at(0, k, 0), at(0, k, 1), at(0, k, 2));
+        if (p.allFinite() && p.z() > 0.0f) record.points.push_back(p);
+      }
+      return record;
+    }
+    if (static_cast<int>(cloud.width) != camera_.width || static_cast<int>(cloud.height) != camera_.height)
+      bag_.fail(spec_.depth_topic, i, "organised cloud is " + std::to_string(cloud.width) + "x" +
+                                          std::to_string(cloud.height) + ", the camera " + std::to_string(camera_.width) +
+                                          "x" + std::to_string(camera_.height));
+    record.width = camera_.width;
+    record.height = camera_.height;
+    record.depth.resize(points);
+    for (std::size_t k = 0; k < points; ++k) {
+      const Eigen::Vector3f p(at(k / cloud.width, k % cloud.width, 0), at(k / cloud.width, k % cloud.width, 1),
+                              at(k / cloud.width, k % cloud.width, 2));
+      const bool valid = p.allFinite() && p.z() > 0.0f;
+      record.depth[k] = valid ? p.z() : 0.0;
+      if (valid) record.points.push_back(p);
+    }
+    return record;
+  }
 
   SequenceSpec spec_;
   BagFile bag_;
@@ -224,6 +280,7 @@ class BagReader final : public RecordReader {
   std::vector<StampedPose> poses_;
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
+  boost::shared_ptr<void> current_;  // the message being decoded
   int next_ = 0;
   int count_ = 0;
   double last_stamp_ = 0.0;
@@ -233,6 +290,20 @@ class BagReader final : public RecordReader {
 
 std::unique_ptr<RecordReader> open_rosbag_reader(const SequenceSpec& spec) {
   return std::make_unique<BagReader>(spec);
+}
+
+std::vector<BagTopic> list_rosbag_topics(const fs::path& file) {
+  BagFile bag(file);
+  std::vector<BagTopic> topics;
+  rosbag::View all(bag.bag());
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) {
+    rosbag::View one(bag.bag(), rosbag::TopicQuery(c->topic));
+    topics.push_back({c->topic, c->datatype, static_cast<long long>(one.size())});
+  }
+  std::sort(topics.begin(), topics.end(), [](const BagTopic& a, const BagTopic& b) { return a.topic < b.topic; });
+  topics.erase(std::unique(topics.begin(), topics.end(), [](const BagTopic& a, const BagTopic& b) { return a.topic == b.topic; }),
+               topics.end());
+  return topics;
 }
 
 struct RosbagWriter::Impl {
@@ -292,8 +363,10 @@ void RosbagWriter::camera_info(const std::string& topic, double stamp, const std
   impl_->bag.write(topic, info.header.stamp, info);
 }
 
-void RosbagWriter::transform(const std::string& topic, double stamp, const std::string& parent,
-                             const std::string& child, const Eigen::Isometry3d& parent_T_child) {
+namespace {
+
+geometry_msgs::TransformStamped transform_message(double stamp, const std::string& parent,
+                                                  const std::string& child, const Eigen::Isometry3d& parent_T_child) {
   geometry_msgs::TransformStamped t;
   t.header.stamp = ros::Time(stamp);
   t.header.frame_id = parent;
@@ -303,7 +376,55 @@ void RosbagWriter::transform(const std::string& topic, double stamp, const std::
   t.transform.translation.x = p.x(), t.transform.translation.y = p.y(), t.transform.translation.z = p.z();
   t.transform.rotation.x = q.x(), t.transform.rotation.y = q.y(), t.transform.rotation.z = q.z();
   t.transform.rotation.w = q.w();
-  impl_->bag.write(topic, t.header.stamp, t);
+  return t;
+}
+
+}  // namespace
+
+void RosbagWriter::transform(const std::string& topic, double stamp, const std::string& parent,
+                             const std::string& child, const Eigen::Isometry3d& parent_T_child) {
+  impl_->bag.write(topic, ros::Time(stamp), transform_message(stamp, parent, child, parent_T_child));
+}
+
+void RosbagWriter::tf(const std::string& topic, double stamp, const std::vector<Link>& links) {
+  tf2_msgs::TFMessage message;
+  for (const Link& l : links) message.transforms.push_back(transform_message(stamp, l.parent, l.child, l.parent_T_child));
+  impl_->bag.write(topic, ros::Time(stamp), message);
+}
+
+void RosbagWriter::point_cloud(const std::string& topic, double stamp, const std::string& frame_id,
+                               const sim::CameraSpec& camera, const std::vector<float>& metres, bool organised) {
+  std::vector<float> xyz;
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const float z = metres[static_cast<std::size_t>(v) * camera.width + u];
+      const bool valid = z > 0.0f && std::isfinite(z);
+      if (!valid && !organised) continue;
+      const float x = static_cast<float>((u - camera.cx) * z / camera.fx);
+      const float y = static_cast<float>((v - camera.cy) * z / camera.fy);
+      xyz.insert(xyz.end(), {valid ? x : NAN, valid ? y : NAN, valid ? z : NAN});
+    }
+  }
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.stamp = ros::Time(stamp);
+  cloud.header.frame_id = frame_id;
+  cloud.height = organised ? static_cast<std::uint32_t>(camera.height) : 1;
+  cloud.width = static_cast<std::uint32_t>(organised ? camera.width : xyz.size() / 3);
+  for (const char* name : {"x", "y", "z"}) {
+    sensor_msgs::PointField field;
+    field.name = name;
+    field.offset = static_cast<std::uint32_t>(4 * cloud.fields.size());
+    field.datatype = sensor_msgs::PointField::FLOAT32;
+    field.count = 1;
+    cloud.fields.push_back(field);
+  }
+  cloud.is_bigendian = false;
+  cloud.point_step = 12;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = !organised;
+  cloud.data.resize(xyz.size() * 4);
+  std::memcpy(cloud.data.data(), xyz.data(), cloud.data.size());
+  impl_->bag.write(topic, cloud.header.stamp, cloud);
 }
 
 void RosbagWriter::close() { impl_->bag.close(); }

@@ -14,12 +14,21 @@
 namespace sonomap::harness {
 
 // The bag reader of a sequence file's ros1_bag source: depth (sensor_msgs/Image, 16UC1 or
-// 32FC1), intrinsics (given, or the first sensor_msgs/CameraInfo on camera.info_topic), poses
+// 32FC1, or sensor_msgs/PointCloud2 with float32 x, y, z in the camera optical frame: an
+// organised cloud gives a depth image, an unorganised one points only), intrinsics (given, or the first sensor_msgs/CameraInfo on camera.info_topic), poses
 // (geometry_msgs/TransformStamped or PoseStamped), each depth frame taking the pose nearest in
 // header time (or interpolated) within time.tolerance. Throws InputError naming the bag, the
 // topic and the message index for a truncated bag, a missing topic, a wrong message type,
 // stamps out of order, or a frame with no pose.
 std::unique_ptr<RecordReader> open_rosbag_reader(const SequenceSpec& spec);
+
+// The topics of a bag with their message type and count, in topic order (what `rosbag info`
+// shows). Throws InputError naming the bag when it cannot be read.
+struct BagTopic {
+  std::string topic, type;
+  long long messages = 0;
+};
+std::vector<BagTopic> list_rosbag_topics(const std::filesystem::path& file);
 
 // Writes a ROS1 bag (create or replace `file`). Stamps are seconds (> 0).
 class RosbagWriter {
@@ -39,6 +48,17 @@ class RosbagWriter {
                    const sim::CameraSpec& camera);
   void transform(const std::string& topic, double stamp, const std::string& parent,
                  const std::string& child, const Eigen::Isometry3d& parent_T_child);
+  // sensor_msgs/PointCloud2 of a depth image: organised (height rows of width points; x, y, z
+  // float32 in the camera optical frame, NaN where there is no return, as RGB-D drivers publish
+  // it), or unorganised (one row of the valid points only).
+  void point_cloud(const std::string& topic, double stamp, const std::string& frame_id,
+                   const sim::CameraSpec& camera, const std::vector<float>& metres, bool organised = true);
+  // tf2_msgs/TFMessage with one transform per (parent, child, parent_T_child).
+  struct Link {
+    std::string parent, child;
+    Eigen::Isometry3d parent_T_child;
+  };
+  void tf(const std::string& topic, double stamp, const std::vector<Link>& links);
   void close();
 
  private:

@@ -202,8 +202,9 @@ void to_json(json& j, const RunSummary& s) {
            {"seed", s.seed},
            {"code_version", s.code_version},
            {"ground_truth", s.ground_truth},
-           {"ground_truth_note", s.ground_truth ? "exact wedge minima from the scenario's geometry"
-                                                : "recorded data: no ground truth, no metrics"},
+           {"ground_truth_note", !s.ground_truth_note.empty() ? s.ground_truth_note
+                                 : s.ground_truth ? "exact wedge minima from the scenario's geometry"
+                                                  : "recorded data: no ground truth, no metrics"},
            {"config", s.config},
            {"config_hash", config_hash(s.config)},
            {"evaluated_frames", s.evaluated_frames},

@@ -92,6 +92,7 @@ struct RunSummary {
   std::uint64_t seed = 0;
   std::string code_version;
   bool ground_truth = false;
+  std::string ground_truth_note;  // where the truth came from; empty: the default text
   RunConfig config;
   int evaluated_frames = 0;
   std::map<std::string, std::string> tags;

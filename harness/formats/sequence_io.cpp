@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/formats/sequence_io.hpp"
 
+#include "core/ground_plane.hpp"
+#include "harness/formats/mesh_io.hpp"
 #include "harness/formats/rosbag_io.hpp"
 #include "harness/formats/tum_io.hpp"
 #include "harness/support/errors.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <fstream>
 #include <sstream>
 #include <system_error>
@@ -173,6 +177,7 @@ RecordedSequence::RecordedSequence(SequenceSpec spec, std::unique_ptr<RecordRead
   if (reader_->count() < 1) throw InputError(spec_.file.string(), 0, "", "the recording has no frame");
   const DepthRecord first = reader_->read(0);
   time_zero_ = first.time;
+  depth_images_ = !first.depth.empty();
   const double median = median_depth(first);
   if (median < kPlausibleMedianMin || median > kPlausibleMedianMax)
     throw InputError(spec_.file.string(), 0, "sequence.depth.scale",
@@ -180,8 +185,89 @@ RecordedSequence::RecordedSequence(SequenceSpec spec, std::unique_ptr<RecordRead
                          " m is not plausible for an RGB-D camera; check depth.scale (units per "
                          "metre: millimetres 1000, TUM 5000) and depth.encoding");
   ground_z_ = spec_.floor.value_or(0.0);
+  if (spec_.auto_floor) detect_floor(first);
   if (spec_.listener_height)
     ground_z_ = aligned(0, first).world_T_body.translation().z() - *spec_.listener_height;
+  load_truth();
+}
+
+namespace {
+
+// The floor plane among the first frames' points (in the recording's world), found in a frame
+// turned so that the guessed up is z, then again among the points at or below the plane found,
+// turned by its normal, until no more than 1 % of the points lie 5 cm below it: a first pass may
+// pick a table top or the top of a box, or lean on the walls' feet when the guess is tilted.
+Eigen::Vector3d floor_normal(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d up, double& offset) {
+  GroundPlaneConfig config;
+  std::vector<Eigen::Vector3d> candidates = points;
+  for (int pass = 0; pass < 8; ++pass) {
+    const Eigen::Quaterniond to_z = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ());
+    std::vector<Eigen::Vector3f> turned;
+    turned.reserve(candidates.size());
+    for (const Eigen::Vector3d& p : candidates) turned.push_back((to_z * p).cast<float>());
+    const GroundPlane plane = estimate_ground_plane(turned, config);
+    const bool moved = pass == 0 || std::abs(plane.offset - offset) > 0.01;  // the floor went down
+    up = to_z.inverse() * plane.normal;
+    offset = plane.offset;
+    std::size_t below = 0;
+    candidates.clear();
+    for (const Eigen::Vector3d& p : points) {
+      const double height = up.dot(p) + offset;
+      below += height < -0.05;
+      if (height < 0.05) candidates.push_back(p);
+    }
+    if (!moved && below <= points.size() / 100) break;
+    config.max_tilt_deg = 10.0;  // from the second pass on, the guess is close
+  }
+  return up;
+}
+
+}  // namespace
+
+// Sets the up axis and the floor from the floor plane of the first floor_frames frames; the
+// first guess is the given up axis, or the first camera's up (optical -y).
+void RecordedSequence::detect_floor(const DepthRecord& first) {
+  const Eigen::Vector3d guess =
+      spec_.up_given ? spec_.up : -(first.world_T_camera * spec_.pose_T_camera).linear().col(1);
+  const int frames = std::min(reader_->count(), spec_.floor_frames);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < frames; ++i) {
+    DepthRecord record = i == 0 ? first : reader_->read(i);
+    record.world_T_camera = record.world_T_camera * spec_.pose_T_camera;
+    const Frame frame = frame_from_record(i, record, 0.0, reader_->camera());
+    const std::size_t stride = 1 + frame.points_camera.size() / 20000;  // enough for a plane
+    for (std::size_t k = 0; k < frame.points_camera.size(); k += stride)
+      points.push_back(frame.world_T_camera * frame.points_camera[k].cast<double>());
+  }
+  double offset = 0.0;
+  Eigen::Vector3d normal;
+  try {
+    normal = floor_normal(points, guess, offset);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(spec_.file.string(), 0, "sequence.world.floor",
+                     "auto: no floor plane within 30 degrees of the guessed up axis in the first " +
+                         std::to_string(frames) + " frames (" + e.what() + "); give world.up and world.floor");
+  }
+  up_T_world_ = Eigen::Isometry3d::Identity();
+  up_T_world_.linear() = Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  ground_z_ = -offset;  // normal . p + offset = 0, the normal turned onto z
+}
+
+void RecordedSequence::load_truth() {
+  if (spec_.truth_file.empty()) return;
+  const Eigen::Isometry3d up_T_truth = up_T_world_ * spec_.world_T_truth;
+  if (!spec_.truth_is_mesh) {
+    truth_cloud_ = load_point_cloud(spec_.truth_file);
+    for (Eigen::Vector3f& p : *truth_cloud_) p = (up_T_truth * p.cast<double>()).cast<float>();
+    return;
+  }
+  const sim::TriangleMesh mesh = load_mesh(spec_.truth_file);
+  truth_mesh_.emplace();
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    sim::WorldTriangle w;
+    for (int c = 0; c < 3; ++c) w[c] = up_T_truth * mesh.vertices[t[c]].cast<double>();
+    truth_mesh_->push_back(w);
+  }
 }
 
 Frame RecordedSequence::aligned(int i, const DepthRecord& record) const {

@@ -6,9 +6,11 @@
 #include "core/types.hpp"
 #include "harness/formats/sequence_frame.hpp"
 #include "harness/formats/sequence_yaml.hpp"
+#include "sim/world_geometry.hpp"
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace sonomap::harness {
@@ -33,8 +35,14 @@ class RecordedSequence {
   // ground_z(); world_T_camera = aligned recorded pose * pose_T_camera.
   Frame frame(int i);
   double ground_z() const { return ground_z_; }
+  bool depth_images() const { return depth_images_; }  // frame 0 had an image (not bare points)
+  // The sequence file's reference (truth.cloud or truth.mesh) in the z-up world; null without.
+  const std::vector<Eigen::Vector3f>* truth_cloud() const { return truth_cloud_ ? &*truth_cloud_ : nullptr; }
+  const std::vector<sim::WorldTriangle>* truth_mesh() const { return truth_mesh_ ? &*truth_mesh_ : nullptr; }
 
  private:
+  void load_truth();
+  void detect_floor(const DepthRecord& first);
   Frame aligned(int i, const DepthRecord& record) const;
   SequenceSpec spec_;
   std::unique_ptr<RecordReader> reader_;
@@ -42,6 +50,9 @@ class RecordedSequence {
   Eigen::Isometry3d up_T_world_ = Eigen::Isometry3d::Identity();
   double time_zero_ = 0.0;
   double ground_z_ = 0.0;
+  bool depth_images_ = true;
+  std::optional<std::vector<Eigen::Vector3f>> truth_cloud_;
+  std::optional<std::vector<sim::WorldTriangle>> truth_mesh_;
 };
 
 // A TUM RGB-D folder (z up, floor at z = 0) or a sequence file. Throws InputError naming the

@@ -125,10 +125,11 @@ void read_depth(const Section& top, SequenceSpec& spec) {
   const Section depth = top.section("depth", {"pattern", "topic", "encoding", "scale"});
   if (spec.source == SequenceSource::Folder) spec.depth_pattern = depth.text("pattern");
   if (spec.source == SequenceSource::Ros1Bag) spec.depth_topic = depth.text("topic");
-  const std::string encoding = depth.choice("encoding", {"16UC1", "32FC1"});
-  spec.encoding = encoding == "16UC1" ? DepthEncoding::Mono16 : DepthEncoding::Float32;
-  if (spec.encoding == DepthEncoding::Float32) {
-    if (depth.has("scale")) depth.fail(YAML::Node(), "scale", "32FC1 depth is in metres; remove scale");
+  const std::string encoding = depth.choice("encoding", {"16UC1", "32FC1", "PointCloud2"});
+  spec.encoding = encoding == "16UC1" ? DepthEncoding::Mono16
+                  : encoding == "32FC1" ? DepthEncoding::Float32 : DepthEncoding::PointCloud2;
+  if (spec.encoding != DepthEncoding::Mono16) {
+    if (depth.has("scale")) depth.fail(YAML::Node(), "scale", encoding + " depth is in metres; remove scale");
   } else if (!depth.has("scale")) {
     depth.fail(YAML::Node(), "scale",
                "missing: say how many 16UC1 units make a metre (millimetre PNGs: 1000, TUM: 5000)");
@@ -178,11 +179,16 @@ void read_poses(const Section& top, SequenceSpec& spec) {
 
 void read_world_and_time(const Section& top, SequenceSpec& spec) {
   if (top.has("world")) {
-    const Section world = top.section("world", {"up", "floor", "listener_height"});
-    if (world.has("up")) spec.up = up_axis(world);
+    const Section world = top.section("world", {"up", "floor", "listener_height", "floor_frames"});
+    spec.up_given = world.has("up");
+    if (spec.up_given) spec.up = up_axis(world);
     if (world.has("floor") && world.has("listener_height"))
       world.fail(YAML::Node(), "floor", "give floor or listener_height, not both");
-    if (world.has("floor")) spec.floor = world.number("floor", -1e4, 1e4);
+    spec.auto_floor = world.has("floor") && world.text("floor") == "auto";
+    if (world.has("floor") && !spec.auto_floor) spec.floor = world.number("floor", -1e4, 1e4);
+    if (world.has("floor_frames") && !spec.auto_floor)
+      world.fail(YAML::Node(), "floor_frames", "only used with floor: auto");
+    if (world.has("floor_frames")) spec.floor_frames = world.whole("floor_frames", 1, 1000);
     if (world.has("listener_height")) spec.listener_height = world.number("listener_height", 0.0, 10.0);
   }
   if (top.has("time")) {
@@ -190,6 +196,17 @@ void read_world_and_time(const Section& top, SequenceSpec& spec) {
     spec.time_tolerance = time.number_or("tolerance", 0.0, 10.0, spec.time_tolerance);
     if (time.has("match")) spec.interpolate = time.choice("match", {"nearest", "interpolate"}) == "interpolate";
   }
+}
+
+void read_truth(const Section& top, SequenceSpec& spec) {
+  if (!top.has("truth")) return;
+  const Section truth = top.section("truth", {"cloud", "mesh", "world_T_truth"});
+  if (truth.has("cloud") == truth.has("mesh"))
+    truth.fail(YAML::Node(), "cloud", "give the reference as cloud (points) or mesh (triangles), one of them");
+  spec.truth_is_mesh = truth.has("mesh");
+  spec.truth_file = truth.text(spec.truth_is_mesh ? "mesh" : "cloud");
+  if (spec.truth_file.is_relative()) spec.truth_file = spec.file.parent_path() / spec.truth_file;
+  if (truth.has("world_T_truth")) spec.world_T_truth = truth.transform("world_T_truth");
 }
 
 YAML::Node load(const fs::path& file) {
@@ -230,7 +247,7 @@ SequenceSpec load_sequence_spec(const fs::path& file) {
   if (!root.IsMap() || !root["sequence"].IsDefined())
     throw InputError(file.string(), 0, "sequence", "expected a top-level 'sequence:' map (see docs/real-data.md)");
   const Section top(file, root["sequence"], "sequence",
-                    {"name", "source", "path", "depth", "frames", "camera", "poses", "world", "time"});
+                    {"name", "source", "path", "depth", "frames", "camera", "poses", "world", "time", "truth"});
   SequenceSpec spec;
   spec.file = file;
   const std::string source = top.choice("source", {"tum", "folder", "ros1_bag"});
@@ -259,6 +276,7 @@ SequenceSpec load_sequence_spec(const fs::path& file) {
     top.fail(YAML::Node(), "frames", "only a folder source lists its frames (use run --frames)");
   }
   read_world_and_time(top, spec);
+  read_truth(top, spec);
   return spec;
 }
 

@@ -15,7 +15,8 @@
 namespace sonomap::harness {
 
 enum class SequenceSource { Tum, Folder, Ros1Bag };
-enum class DepthEncoding { Mono16, Float32 };  // 16UC1 (units of 1/scale metre), 32FC1 (metres)
+// 16UC1 (units of 1/scale metre), 32FC1 (metres), sensor_msgs/PointCloud2 (metres, bags only)
+enum class DepthEncoding { Mono16, Float32, PointCloud2 };
 enum class PoseFormat { Tum, Matrix4x4, Kitti, Topic };
 
 struct SequenceSpec {
@@ -29,7 +30,7 @@ struct SequenceSpec {
   std::string depth_pattern;
   int first = 0;
   int count = 0;
-  std::string depth_topic;  // ROS1 bag: sensor_msgs/Image
+  std::string depth_topic;  // ROS1 bag: sensor_msgs/Image or PointCloud2
   DepthEncoding encoding = DepthEncoding::Mono16;
   double depth_scale = 1.0;  // 16UC1 units per metre (millimetres: 1000)
 
@@ -47,8 +48,20 @@ struct SequenceSpec {
   // The recording's world axis that points up (a unit axis, +-x, +-y or +-z) and the floor:
   // its height along that axis, or the listener's height above it at the first frame.
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  bool up_given = false;
   std::optional<double> floor;
   std::optional<double> listener_height;
+  // floor: auto: the floor plane found (RANSAC) in the first `floor_frames` frames sets the up
+  // axis (its normal; `up`, when given, or else the first camera's up is the starting guess,
+  // within 30 degrees) and the floor.
+  bool auto_floor = false;
+  int floor_frames = 10;
+
+  // Ground truth: a reference point cloud or mesh of the scene (PLY, OBJ, STL), in the frame
+  // world_T_truth places in the recording's world. Empty: the recording has no truth.
+  std::filesystem::path truth_file;
+  bool truth_is_mesh = false;
+  Eigen::Isometry3d world_T_truth = Eigen::Isometry3d::Identity();
 
   double time_tolerance = 0.02;  // seconds between a depth frame and its pose
   bool interpolate = false;      // bags: interpolate between the poses around a frame
