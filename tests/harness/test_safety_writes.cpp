@@ -119,9 +119,13 @@ TEST_CASE("a stale staging folder of a dead process is removed by the next run, 
 
 namespace {
 
-// Whether process `pid` has a handler installed for `signal` (the SigCgt mask of
-// /proc/PID/status), i.e. sonomap will stop cleanly rather than die of it.
+// Whether process `pid` runs sonomap (it has exec'd: the test's own handlers, inherited by the
+// fork, are gone) and has a handler installed for `signal` (the SigCgt mask of
+// /proc/PID/status), i.e. it will stop cleanly rather than die of it.
 bool catches(pid_t pid, int signal) {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/" + std::to_string(pid) + "/exe", ec);
+  if (ec || exe != fs::canonical(std::getenv("SONOMAP_EXE"))) return false;
   std::ifstream in("/proc/" + std::to_string(pid) + "/status");
   std::string line;
   while (std::getline(in, line))
