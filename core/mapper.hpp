@@ -69,7 +69,8 @@ class Mapper {
     vertices.clear();
     triangles.clear();
   }
-  // The configuration as (key, value) text, for summary.json. A registered mapper's "voxel"
+  // The configuration as (key, value) text, for summary.json. Only mappers registered from
+  // outside use it (the built-in ones are recorded from their settings tables); a "voxel"
   // entry (metres) sets the ghost tolerance of the metrics to two voxels.
   virtual std::vector<std::pair<std::string, std::string>> config_entries() const { return {}; }
   // Bytes held by the map (grids, caches); 0 if the map does not know.

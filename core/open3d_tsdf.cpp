@@ -164,15 +164,6 @@ void Open3dTsdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
   triangles = volume_->mesh.triangles;
 }
 
-std::vector<std::pair<std::string, std::string>> Open3dTsdf::config_entries() const {
-  return {{"mapper", name()},
-          {"voxel", std::to_string(config_.voxel)},
-          {"truncation", std::to_string(config_.truncation)},
-          {"block_resolution", std::to_string(kBlockResolution)},
-          {"min_range", std::to_string(config_.min_range)},
-          {"max_range", std::to_string(config_.max_range)}};
-}
-
 size_t Open3dTsdf::memory_bytes() const {
   size_t bytes = 0;
   for (const auto& unit : volume_->tsdf.volume_units_)

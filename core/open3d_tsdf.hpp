@@ -40,7 +40,6 @@ class Open3dTsdf final : public Mapper {
   StageTimes last_stage_times() const override { return times_; }
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                     std::vector<Eigen::Vector3i>& triangles) const override;
-  std::vector<std::pair<std::string, std::string>> config_entries() const override;
   // Open3D's voxel storage of the allocated blocks plus the cached mesh.
   size_t memory_bytes() const override;
 

@@ -122,17 +122,6 @@ void Tsdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
   fused_.surface_mesh(vertices, triangles);
 }
 
-std::vector<std::pair<std::string, std::string>> Tsdf::config_entries() const {
-  return {{"mapper", name()},
-          {"voxel", std::to_string(config_.voxel)},
-          {"truncation", std::to_string(config_.truncation)},
-          {"space_carving", config_.space_carving ? "true" : "false"},
-          {"weight_cap", std::to_string(config_.weight_cap)},
-          {"min_weight", std::to_string(config_.min_weight)},
-          {"min_range", std::to_string(config_.min_range)},
-          {"max_range", std::to_string(config_.max_range)}};
-}
-
 size_t Tsdf::memory_bytes() const {
   return fused_.memory_bytes();
 }

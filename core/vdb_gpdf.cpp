@@ -553,34 +553,6 @@ void VdbGpdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
   fused_.surface_mesh(vertices, triangles);
 }
 
-std::vector<std::pair<std::string, std::string>> VdbGpdf::config_entries() const {
-  const auto& c = config_;
-  auto num = [](double v) { return std::to_string(v); };
-  return {{"mapper", name()},
-          {"local_voxel", num(c.local_voxel)},
-          {"voxel_downsample", std::to_string(c.voxel_downsample)},
-          {"global_voxel", num(c.global_voxel)},
-          {"kernel", c.kernel == GpKernel::RevertingSE ? "reverting_se" : "log_gpis_matern32"},
-          {"lambda", num(c.lambda)},
-          {"map_noise", num(c.map_noise)},
-          {"query_step", num(c.query_step)},
-          {"trunc_behind", std::to_string(c.trunc_behind)},
-          {"trunc_front", std::to_string(c.trunc_front)},
-          {"free_space_carving", c.free_space_carving ? "true" : "false"},
-          {"carving_step", num(c.carving_step)},
-          {"variance_cap", num(c.variance_cap)},
-          {"inverse_variance_fusion", c.inverse_variance_fusion ? "true" : "false"},
-          {"weight_cap", num(c.weight_cap)},
-          {"g_gpdf_min_touched", std::to_string(c.g_gpdf_min_touched)},
-          {"smooth_min", num(c.smooth_min)},
-          {"global_neighbours", std::to_string(c.global_neighbours)},
-          {"query_radius", num(c.query_radius)},
-          {"gradient_scale", num(c.gradient_scale)},
-          {"recon_min_weight", num(c.recon_min_weight)},
-          {"min_range", num(c.min_range)},
-          {"max_range", num(c.max_range)}};
-}
-
 size_t VdbGpdf::memory_bytes() const {
   size_t bytes = fused_.memory_bytes();
   for (const auto& kv : global_) {

@@ -72,7 +72,6 @@ class VdbGpdf final : public Mapper {
   StageTimes last_stage_times() const override { return times_; }
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                     std::vector<Eigen::Vector3i>& triangles) const override;
-  std::vector<std::pair<std::string, std::string>> config_entries() const override;
   size_t memory_bytes() const override;
 
   const VdbGpdfConfig& config() const { return config_; }

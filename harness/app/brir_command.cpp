@@ -26,9 +26,9 @@ void add_brir_command(CLI::App& app, const GlobalOptions& global) {
                   "Output directory: new, empty, or an earlier sonomap result (replaced atomically)")
       ->required();
   cmd->add_option("--author-contact", state->meta.author_contact,
-                  "AES69 AuthorContact written in every file")->capture_default_str();
+                  "AES69 AuthorContact written in every file");
   cmd->add_option("--organization", state->meta.organization,
-                  "AES69 Organization written in every file")->capture_default_str();
+                  "AES69 Organization written in every file");
   cmd->callback([state, &global] {
     check_output_directory(state->out, {state->room.hrir_file});  // before the work
     const audio::BrirSynthConfig room = room_config(state->room, 48000.0);

@@ -164,94 +164,123 @@ void append_command_variant(const SweepReader& r, const YAML::Node& v, const std
                            "--timeout", fmt::format("{}", timeout), "--sequence-cache", (out / "sequences").string()});
 }
 
-}  // namespace
-
-Sweep load_sweep(const fs::path& file, const fs::path& out) {
-  YAML::Node root;
+YAML::Node load_sweep_yaml(const fs::path& file) {
   try {
-    root = YAML::LoadFile(file.string());
+    return YAML::LoadFile(file.string());
   } catch (const YAML::BadFile&) {
     throw InputError(file.string() + ": cannot open the sweep file");
   } catch (const YAML::ParserException& e) {
     throw InputError(file.string(), e.mark.line + 1, "", "malformed YAML: " + e.msg);
   }
+}
+
+int positive(const SweepReader& r, const YAML::Node& node, const std::string& key) {
+  const int v = r.scalar<int>(node, key);
+  if (v < 1) r.fail(node, key, "must be at least 1");
+  return v;
+}
+
+// What a sweep's jobs share (the file's top level), or one scenario entry of it.
+struct JobBase {
+  fs::path scenario_file;
+  std::string scenario_id;
+  int frames = 0, every = 0;  // 0: the scenario's own
+  std::vector<std::string> set, pictures, sweeps;
+  std::vector<std::uint64_t> seeds{1};
+  bool listen = false;  // each run writes listen.wav (the same walk per scenario: A/B by ear)
+};
+
+JobBase read_top_level(const SweepReader& r, const YAML::Node& root) {
+  JobBase top;
+  top.set = r.strings(root["set"], "set");
+  top.pictures = r.strings(root["pictures"], "pictures");
+  top.sweeps = r.strings(root["sweeps"], "sweeps");
+  top.listen = root["listen"] && r.scalar<bool>(root["listen"], "listen");
+  if (root["seeds"]) {
+    if (!root["seeds"].IsSequence() || root["seeds"].size() == 0) r.fail(root["seeds"], "seeds", "expected a non-empty list");
+    top.seeds.clear();
+    for (std::size_t i = 0; i < root["seeds"].size(); ++i)
+      top.seeds.push_back(r.scalar<std::uint64_t>(root["seeds"][i], "seeds[" + std::to_string(i) + "]"));
+  }
+  if (root["frames"]) top.frames = positive(r, root["frames"], "frames");
+  if (root["every"]) top.every = positive(r, root["every"], "every");
+  for (const char* list : {"scenarios", "variants"})
+    if (!root[list] || !root[list].IsSequence() || root[list].size() == 0)
+      r.fail(root[list] ? root[list] : root, list, "expected a non-empty list");
+  return top;
+}
+
+// scenarios[si]: its id, file and the settings it overrides, on top of the top level's.
+JobBase read_scenario_entry(const SweepReader& r, const YAML::Node& s, const std::string& skey,
+                            const fs::path& base, const JobBase& top) {
+  r.check_keys(s, skey, {"id", "file", "frames", "every", "set"});
+  if (!s["id"] || !s["file"]) r.fail(s, skey, "needs id and file");
+  JobBase sc = top;
+  sc.scenario_id = r.identifier(s["id"], skey + ".id");
+  sc.scenario_file = base / r.scalar<std::string>(s["file"], skey + ".file");
+  if (!fs::is_regular_file(sc.scenario_file))
+    r.fail(s["file"], skey + ".file", "no such file: " + sc.scenario_file.string());
+  if (s["frames"]) sc.frames = positive(r, s["frames"], skey + ".frames");
+  if (s["every"]) sc.every = positive(r, s["every"], skey + ".every");
+  sc.set = r.strings(s["set"], skey + ".set");
+  return sc;
+}
+
+// The command line of one run: the scenario entry `sc`, variant `v`, one seed.
+std::vector<std::string> job_args(const SweepReader& r, const JobBase& top, const JobBase& sc, const YAML::Node& v,
+                                  const std::string& vkey, std::uint64_t seed, const std::string& sweep_name,
+                                  const fs::path& run_dir, const fs::path& out) {
+  const std::string vid = v["id"].as<std::string>();
+  // An external command evaluates the frames it chooses, has no built-in mapper to set up
+  // (mapper.* keys are for those) and makes no sweeps.
+  const bool external = static_cast<bool>(v["command"]);
+  std::vector<std::string> a = {"--quiet", external ? "score" : "run", sc.scenario_file.string(), "--out",
+                                run_dir.string(), "--seed", std::to_string(seed), "--tag", "scenario=" + sc.scenario_id,
+                                "--tag", "variant=" + vid, "--tag", "sweep=" + sweep_name};
+  if (external) append_command_variant(r, v, vkey, out, a);
+  else a.insert(a.end(), {"--mapper", r.scalar<std::string>(v["mapper"], vkey + ".mapper")});
+  if (v["voxel"]) {
+    const double voxel = r.scalar<double>(v["voxel"], vkey + ".voxel");
+    if (!(voxel > 0)) r.fail(v["voxel"], vkey + ".voxel", "must be positive");
+    a.insert(a.end(), {"--voxel", fmt::format("{}", voxel)});
+  }
+  if (sc.frames > 0) a.insert(a.end(), {"--frames", std::to_string(sc.frames)});
+  if (sc.every > 0 && !external) a.insert(a.end(), {"--every", std::to_string(sc.every)});
+  for (const auto& lists : {top.set, sc.set, r.strings(v["set"], vkey + ".set")})
+    for (const auto& o : lists)
+      if (!external || o.rfind("mapper.", 0) != 0) a.insert(a.end(), {"--set", o});
+  append_frames_list(a, "--pictures", top.pictures);
+  if (!external) append_frames_list(a, "--sweeps", top.sweeps);
+  if (top.listen && !external) a.push_back("--listen");
+  return a;
+}
+
+}  // namespace
+
+Sweep load_sweep(const fs::path& file, const fs::path& out) {
+  const YAML::Node root = load_sweep_yaml(file);
   SweepReader r(file);
   r.check_keys(root, "", {"name", "frames", "every", "seeds", "set", "scenarios", "variants",
                           "pictures", "sweeps", "listen", "description", "claims", "gates"});
   Sweep sweep;
   if (!root["name"]) r.fail(root, "name", "missing");
   sweep.name = r.identifier(root["name"], "name");
-  const std::vector<std::string> common_set = r.strings(root["set"], "set");
-  const std::vector<std::string> pictures = r.strings(root["pictures"], "pictures");
-  const std::vector<std::string> sweeps = r.strings(root["sweeps"], "sweeps");
-  // listen: true -> each run writes listen.wav (same walk per scenario: A/B by ear).
-  const bool listen = root["listen"] && r.scalar<bool>(root["listen"], "listen");
-  std::vector<std::uint64_t> seeds{1};
-  if (root["seeds"]) {
-    if (!root["seeds"].IsSequence() || root["seeds"].size() == 0) r.fail(root["seeds"], "seeds", "expected a non-empty list");
-    seeds.clear();
-    for (std::size_t i = 0; i < root["seeds"].size(); ++i)
-      seeds.push_back(r.scalar<std::uint64_t>(root["seeds"][i], "seeds[" + std::to_string(i) + "]"));
-  }
-  auto positive = [&](const YAML::Node& node, const std::string& key) {
-    const int v = r.scalar<int>(node, key);
-    if (v < 1) r.fail(node, key, "must be at least 1");
-    return v;
-  };
-  const int frames = root["frames"] ? positive(root["frames"], "frames") : 0;
-  const int every = root["every"] ? positive(root["every"], "every") : 0;
-
-  for (const char* list : {"scenarios", "variants"})
-    if (!root[list] || !root[list].IsSequence() || root[list].size() == 0)
-      r.fail(root[list] ? root[list] : root, list, "expected a non-empty list");
-
+  const JobBase top = read_top_level(r, root);
   std::set<std::string> ids;
-  const fs::path base = file.parent_path();
   for (std::size_t si = 0; si < root["scenarios"].size(); ++si) {
-    const YAML::Node s = root["scenarios"][si];
     const std::string skey = "scenarios[" + std::to_string(si) + "]";
-    r.check_keys(s, skey, {"id", "file", "frames", "every", "set"});
-    if (!s["id"] || !s["file"]) r.fail(s, skey, "needs id and file");
-    const std::string sid = r.identifier(s["id"], skey + ".id");
-    const fs::path scenario_file = base / r.scalar<std::string>(s["file"], skey + ".file");
-    if (!fs::is_regular_file(scenario_file))
-      r.fail(s["file"], skey + ".file", "no such file: " + scenario_file.string());
-    const int s_frames = s["frames"] ? positive(s["frames"], skey + ".frames") : frames;
-    const int s_every = s["every"] ? positive(s["every"], skey + ".every") : every;
-    const std::vector<std::string> s_set = r.strings(s["set"], skey + ".set");
-
+    const JobBase sc = read_scenario_entry(r, root["scenarios"][si], skey, file.parent_path(), top);
     for (std::size_t vi = 0; vi < root["variants"].size(); ++vi) {
       const YAML::Node v = root["variants"][vi];
       const std::string vkey = "variants[" + std::to_string(vi) + "]";
       r.check_keys(v, vkey, {"id", "mapper", "voxel", "set", "command", "timeout"});
       if (!v["id"] || !v["mapper"] == !v["command"]) r.fail(v, vkey, "needs id and either mapper or command");
       const std::string vid = r.identifier(v["id"], vkey + ".id");
-      for (std::uint64_t seed : seeds) {
+      for (std::uint64_t seed : top.seeds) {
         Job job;
-        job.id = fmt::format("{}-{}-s{}", sid, vid, seed);
+        job.id = fmt::format("{}-{}-s{}", sc.scenario_id, vid, seed);
         if (!ids.insert(job.id).second) r.fail(v["id"], vkey + ".id", "duplicate run id " + job.id);
-        auto& a = job.args;
-        a = {"--quiet", v["command"] ? "score" : "run", scenario_file.string(), "--out", (out / "runs" / job.id).string(),
-             "--seed", std::to_string(seed), "--tag", "scenario=" + sid, "--tag", "variant=" + vid,
-             "--tag", "sweep=" + sweep.name};
-        if (v["command"]) append_command_variant(r, v, vkey, out, a);
-        else a.insert(a.end(), {"--mapper", r.scalar<std::string>(v["mapper"], vkey + ".mapper")});
-        if (v["voxel"]) {
-          const double voxel = r.scalar<double>(v["voxel"], vkey + ".voxel");
-          if (!(voxel > 0)) r.fail(v["voxel"], vkey + ".voxel", "must be positive");
-          a.insert(a.end(), {"--voxel", fmt::format("{}", voxel)});
-        }
-        if (s_frames > 0) a.insert(a.end(), {"--frames", std::to_string(s_frames)});
-        // An external command evaluates the frames it chooses, has no built-in mapper to set
-        // up (mapper.* keys are for those) and makes no sweeps.
-        const bool external = static_cast<bool>(v["command"]);
-        if (s_every > 0 && !external) a.insert(a.end(), {"--every", std::to_string(s_every)});
-        for (const auto& lists : {common_set, s_set, r.strings(v["set"], vkey + ".set")})
-          for (const auto& o : lists)
-            if (!external || o.rfind("mapper.", 0) != 0) a.insert(a.end(), {"--set", o});
-        append_frames_list(a, "--pictures", pictures);
-        if (!external) append_frames_list(a, "--sweeps", sweeps);
-        if (listen && !external) a.push_back("--listen");
+        job.args = job_args(r, top, sc, v, vkey, seed, sweep.name, out / "runs" / job.id, out);
         sweep.jobs.push_back(std::move(job));
       }
     }
@@ -393,7 +422,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global) {
                   "Output directory (runs/, logs/, rollup.csv, report.md): new, empty, or an "
                   "earlier compare result (resumed)")
       ->required();
-  cmd->add_option("-j,--jobs", o->jobs, "Runs at the same time")->check(CLI::PositiveNumber)->capture_default_str();
+  cmd->add_option("-j,--jobs", o->jobs, "Runs at the same time")->check(CLI::PositiveNumber);
   cmd->add_flag("--emit-jobs", o->emit_jobs,
                 "Print one command per run (for GNU parallel or a Slurm array) and exit; "
                 "then `sonomap report DIR` rolls up");

@@ -4,35 +4,23 @@
 // change B - A and which way it went; exit status 1 when a metric given a tolerance got worse by
 // more than it (or lost its value), 0 otherwise.
 #include "harness/app/cli.hpp"
+#include "harness/formats/run_summary.hpp"
 #include "harness/report/rollup.hpp"
 #include "harness/report/stats.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/fields.hpp"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace sonomap::harness {
 namespace {
-
-json read_summary(const fs::path& dir) {
-  const fs::path file = dir / "summary.json";
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": no such file (not a sonomap result directory)");
-  try {
-    return json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(file.string() + ": not a sonomap summary: " + e.what());
-  }
-}
 
 // "metric=value" -> metric: value, checked against the metric names.
 std::map<std::string, double> parse_tolerances(const std::vector<std::string>& given,
@@ -46,16 +34,19 @@ std::map<std::string, double> parse_tolerances(const std::vector<std::string>& g
     if (eq == std::string::npos || !known)
       throw InputError("--tolerance " + t + ": expected METRIC=VALUE with a metric of summary.json's "
                        "rollup names (e.g. circle_mean_rmse=0.01)");
-    char* end = nullptr;
-    const double v = std::strtod(t.c_str() + eq + 1, &end);
-    if (eq + 1 == t.size() || *end != '\0' || !std::isfinite(v) || v < 0.0)
+    double v = 0.0;
+    if (!parse_number(t.substr(eq + 1), v) || v < 0.0)
       throw InputError("--tolerance " + t + ": the tolerance must be a finite number >= 0");
     out[name] = v;
   }
   return out;
 }
 
-double parse_number(const std::string& text) { return text.empty() ? NAN : std::strtod(text.c_str(), nullptr); }
+// A metric's cell as a number; NaN when empty (undefined).
+double cell_number(const std::string& text) {
+  double v = NAN;
+  return parse_number(text, v) ? v : NAN;
+}
 
 // The change's direction in words, and whether it breaks its tolerance.
 std::pair<std::string, bool> judge(const std::string& metric, double a, double b, const double* tolerance) {
@@ -71,17 +62,17 @@ std::pair<std::string, bool> judge(const std::string& metric, double a, double b
 }
 
 int run_diff(const fs::path& a_dir, const fs::path& b_dir, const std::vector<std::string>& tolerance_args) {
-  const json a = read_summary(a_dir), b = read_summary(b_dir);
+  const RunSummary a = read_run_summary(a_dir), b = read_run_summary(b_dir);
   const auto a_metrics = summary_metrics(a), b_metrics = summary_metrics(b);
   const std::map<std::string, double> tolerances = parse_tolerances(tolerance_args, a_metrics);
-  if (a.value("config_hash", "") != b.value("config_hash", ""))
-    std::printf("note: the two results differ in configuration (config_hash %s vs %s)\n",
-                a.value("config_hash", "?").c_str(), b.value("config_hash", "?").c_str());
+  if (const std::string ha = config_hash(a.config), hb = config_hash(b.config); ha != hb)
+    std::printf("note: the two results differ in configuration (config_hash %s vs %s)\n", ha.c_str(),
+                hb.c_str());
   std::printf("%-28s %12s %12s %12s  %s\n", "metric", "A", "B", "B - A", "");
   int failures = 0;
   for (std::size_t i = 0; i < a_metrics.size(); ++i) {
     const std::string& name = a_metrics[i].first;
-    const double va = parse_number(a_metrics[i].second), vb = parse_number(b_metrics[i].second);
+    const double va = cell_number(a_metrics[i].second), vb = cell_number(b_metrics[i].second);
     const auto tol = tolerances.find(name);
     const auto [word, fails] = judge(name, va, vb, tol == tolerances.end() ? nullptr : &tol->second);
     if (word.empty()) continue;

@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <stdexcept>
 
 namespace sonomap::harness {
 namespace {
@@ -23,21 +22,13 @@ void apply(const FieldTable& table, const std::string& mapper, const std::vector
   }
 }
 
-// Runs the mapper's own validation and reports its message as bad input.
-template <typename Make>
-std::unique_ptr<Mapper> checked(const std::string& mapper, Make make) {
-  try {
-    return make();
-  } catch (const std::invalid_argument& e) {
-    throw InputError("mapper '" + mapper + "': " + e.what());
-  }
-}
-
+// The factories. A config's own validation throws std::invalid_argument, which make_mapper()
+// reports as bad input naming the mapper.
 std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& settings) {
   VdbGpdfConfig c;
   if (voxel > 0) c.global_voxel = voxel;
   apply(vdb_gpdf_fields(c), "vdb_gpdf", settings);
-  return checked("vdb_gpdf", [&] { return std::make_unique<VdbGpdf>(c); });
+  return std::make_unique<VdbGpdf>(c);
 }
 
 // --voxel (when > 0) sets a TSDF's voxel size and keeps its truncation at the same number of voxels.
@@ -51,7 +42,7 @@ std::unique_ptr<Mapper> make_tsdf(double voxel, const std::vector<Setting>& sett
   TsdfConfig c;
   set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
   apply(tsdf_fields(c), "tsdf", settings);
-  return checked("tsdf", [&] { return std::make_unique<Tsdf>(c); });
+  return std::make_unique<Tsdf>(c);
 }
 
 // Open3D's ScalableTSDFVolume with the TSDF peer's voxel and truncation (and the same rule
@@ -70,7 +61,7 @@ std::unique_ptr<Mapper> make_open3d(double voxel, const std::vector<Setting>& se
   Open3dTsdfConfig c = open3d_defaults();
   set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
   apply(open3d_fields(c), "open3d", settings);
-  return checked("open3d", [&] { return std::make_unique<Open3dTsdf>(c); });
+  return std::make_unique<Open3dTsdf>(c);
 }
 
 // Calls `use(name, table)` with each mapper's table over a config of its defaults.

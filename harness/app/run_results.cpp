@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/app/run_results.hpp"
 
-#include "harness/app/result_files.hpp"
+#include "core/types.hpp"
 #include "harness/formats/mesh_io.hpp"
+#include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"
 
 #include <fmt/format.h>
@@ -18,25 +19,69 @@ namespace {
 
 std::string csv_number(double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v) : ""; }
 
-// coverage,rmse,rmse_off_edges,ghosts,known (ghosts empty without truth).
-std::string metrics_csv(const eval::RasterMetrics& m, bool has_truth) {
-  return csv_number(m.coverage) + ',' + csv_number(m.rmse) + ',' + csv_number(m.rmse_off_edges) +
-         ',' + (has_truth ? std::to_string(m.ghosts) : "") + ',' + std::to_string(m.estimate_known);
+// A range for CSV: empty when unknown; fixed precision so reruns compare byte for byte.
+std::string csv_range(const RasterCell& cell) {
+  return cell.known() ? fmt::format("{:.6f}", cell.range) : std::string();
 }
 
-std::string frame_row_csv(const FrameRow& r) {
+// coverage,rmse,rmse_off_edges,ghosts,known (ghosts empty without truth; all empty without
+// the raster).
+std::string metrics_csv(const std::optional<eval::RasterMetrics>& m, bool has_truth) {
+  if (!m) return ",,,,";
+  return csv_number(m->coverage) + ',' + csv_number(m->rmse) + ',' + csv_number(m->rmse_off_edges) +
+         ',' + (has_truth ? std::to_string(m->ghosts) : "") + ',' + std::to_string(m->estimate_known);
+}
+
+// x,y,z,heading_deg of a pose.
+std::string pose_csv(const Eigen::Isometry3d& world_T_body) {
+  const Eigen::Vector3d p = world_T_body.translation();
+  return fmt::format("{:.6f},{:.6f},{:.6f},{:.4f}", p.x(), p.y(), p.z(),
+                     heading_of(world_T_body) * 180.0 / M_PI);
+}
+
+}  // namespace
+
+std::string frames_csv_header() {
+  return "frame,time,x,y,z,heading_deg,"
+         "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
+         "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
+         "cylinder_known,edf_coverage,edf_rmse,edf_rmse_off_edges,edf_ghosts,edf_known,"
+         "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known\n";
+}
+
+std::string frames_csv_row(const FrameRow& r) {
   std::string line = fmt::format("{},{:.6f},", r.frame, r.time) + pose_csv(r.world_T_body_true) +
                      ',' + metrics_csv(r.circle, r.has_truth) + ',' +
                      metrics_csv(r.cylinder, r.has_truth);
   if (r.edf_circle)
-    line += ',' + metrics_csv(*r.edf_circle, r.has_truth) + ',' + csv_number(r.slip.median_deg) +
+    line += ',' + metrics_csv(r.edf_circle, r.has_truth) + ',' + csv_number(r.slip.median_deg) +
             ',' + csv_number(r.slip.p90_deg) + ',' + std::to_string(r.slip.observed);
   else
     line += ",,,,,,,,";
   return line + '\n';
 }
 
-}  // namespace
+void write_circle_rows(std::ostream& out, int frame, const Circle& estimate, const Circle& truth) {
+  for (int k = 0; k < estimate.size(); ++k)
+    out << frame << ',' << k << ',' << csv_range(estimate.bins[k]) << ',' << csv_range(truth.bins[k]) << '\n';
+}
+
+void write_cylinder_rows(std::ostream& out, int frame, const Cylinder& estimate, const Cylinder& truth) {
+  for (int r = 0; r < estimate.rows; ++r)
+    for (int k = 0; k < estimate.azimuth_bins; ++k)
+      out << frame << ',' << r << ',' << k << ',' << csv_range(estimate.at(r, k)) << ','
+          << csv_range(truth.at(r, k)) << '\n';
+}
+
+std::map<std::string, std::string> parse_tags(const std::vector<std::string>& tags) {
+  std::map<std::string, std::string> out;
+  for (const std::string& t : tags) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0) throw InputError("--tag " + t + ": expected key=value");
+    out[t.substr(0, eq)] = t.substr(eq + 1);
+  }
+  return out;
+}
 
 ResultFile::ResultFile(fs::path path) : path_(std::move(path)), out_(path_) {}
 
@@ -64,8 +109,8 @@ RunResults::RunResults(const fs::path& dir, bool write_rasters)
   if (write_rasters) {
     circle_.emplace(dir / "circle.csv");
     cylinder_.emplace(dir / "cylinder.csv");
-    *circle_ << "frame,bin,estimate,truth\n";
-    *cylinder_ << "frame,row,bin,estimate,truth\n";
+    *circle_ << kCircleCsvHeader;
+    *cylinder_ << kCylinderCsvHeader;
   }
 }
 
@@ -81,11 +126,11 @@ void RunResults::add_row(const FrameRow& row) {
   ++evaluated_;
   if (row.has_truth) {
     circle_series_.push_back(row.circle);
-    cylinder_series_.push_back(row.cylinder);
+    cylinder_series_.push_back(*row.cylinder);
     if (row.edf_circle) edf_series_.push_back(*row.edf_circle);
   }
   if (row.edf_circle) slip_series_.push_back(row.slip);
-  frames_ << frame_row_csv(row);
+  frames_ << frames_csv_row(row);
 }
 
 void RunResults::add_rasters(const FrameView& f) {

@@ -2,7 +2,9 @@
 // The files of a result directory (docs/results.md): the per-frame rows as the run goes
 // (frames.csv, circle.csv, cylinder.csv, timings.csv), the final frame's EDF comparison
 // (edf.csv), and at the end summary.json, timings.json and map.ply. Every file is checked
-// when it is closed: a full disk is an error, not a truncated result.
+// when it is closed: a full disk is an error, not a truncated result. `score` writes its
+// frames.csv, circle.csv and cylinder.csv with the same writers, so `report`, `compare` and
+// `diff` read a scored folder exactly like a run's.
 #pragma once
 
 #include "core/edf_raster.hpp"
@@ -46,6 +48,9 @@ class ResultFile {
 // Writes `text` to `path`, checked.
 void write_result_file(const std::filesystem::path& path, const std::string& text);
 
+// "key=value" labels (--tag) as summary.json's "tags"; InputError naming a malformed one.
+std::map<std::string, std::string> parse_tags(const std::vector<std::string>& tags);
+
 // One evaluated frame as the result files, pictures and sweeps see it.
 struct FrameView {
   int index = 0;
@@ -64,12 +69,23 @@ struct FrameRow {
   double time = 0.0;
   Eigen::Isometry3d world_T_body_true = Eigen::Isometry3d::Identity();
   bool has_truth = false;
-  eval::RasterMetrics circle, cylinder;
+  eval::RasterMetrics circle;
+  std::optional<eval::RasterMetrics> cylinder;    // empty cells: no cylinder (score without one)
   std::optional<eval::RasterMetrics> edf_circle;  // frames with the EDF comparison
   SlipStats slip;
   static FrameRow of(int frame, double time, const Eigen::Isometry3d& world_T_body_true,
                      const eval::FrameEvaluation& evaluation);
 };
+
+// frames.csv's header line and one row (each with its newline).
+std::string frames_csv_header();
+std::string frames_csv_row(const FrameRow& row);
+
+// circle.csv / cylinder.csv: header lines, and the rows of one frame, estimate beside truth.
+inline constexpr const char* kCircleCsvHeader = "frame,bin,estimate,truth\n";
+inline constexpr const char* kCylinderCsvHeader = "frame,row,bin,estimate,truth\n";
+void write_circle_rows(std::ostream& out, int frame, const Circle& estimate, const Circle& truth);
+void write_cylinder_rows(std::ostream& out, int frame, const Cylinder& estimate, const Cylinder& truth);
 
 // The result files written as the run goes, and the metric series the summary is made of.
 class RunResults {

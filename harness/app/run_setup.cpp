@@ -3,7 +3,7 @@
 
 #include "harness/app/cli.hpp"
 #include "harness/app/mapper_factory.hpp"
-#include "harness/app/result_files.hpp"
+#include "harness/app/run_results.hpp"
 #include "harness/support/errors.hpp"
 
 #include <algorithm>
@@ -13,7 +13,7 @@ RunInputs load_run_inputs(const RunOptions& options) {
   if (options.frames < 0) throw InputError("--frames must be positive, got " + std::to_string(options.frames));
   if (options.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(options.every));
   RunInputs inputs;
-  inputs.tags = tags_json(options.tags).get<std::map<std::string, std::string>>();
+  inputs.tags = parse_tags(options.tags);
   std::vector<std::string> scenario_overrides;
   split_overrides(options.overrides, scenario_overrides, inputs.settings);
   inputs.source = open_frame_source(options.scenario, std::move(scenario_overrides),
@@ -53,7 +53,7 @@ RunSummary describe_run(const RunOptions& options, const RunInputs& inputs, cons
   for (const auto& [key, value] : mapper_config_entries(mapper)) c.mapper_config[key] = value;
   c.raster = settings.raster;
   c.metrics = settings.metrics;
-  c.edf = {settings.edf_enabled, settings.edf_every, settings.edf_trace_rows, settings.edf};
+  c.edf = EdfSettings{settings.edf_enabled, settings.edf_every, settings.edf_trace_rows, settings.edf};
   c.frames = source.frame_count();
   c.every = options.every;
   c.seed = source.seed();

@@ -3,7 +3,7 @@
 
 #include "harness/app/frame_source.hpp"
 #include "harness/app/render_command.hpp"
-#include "harness/app/result_files.hpp"
+#include "harness/app/run_results.hpp"
 #include "harness/app/run_settings.hpp"
 
 #include "eval/evaluate_frame.hpp"
@@ -142,21 +142,16 @@ Estimates read_estimates(const fs::path& circle, const fs::path& cylinder, const
 }
 
 // The config summary.json records (the raster and metric settings the scores depend on).
-json score_config(const ScoreOptions& o, const RunSettings& s, int frames, std::uint64_t seed) {
-  return json{{"mapper", o.name}, {"mapper_config", json::object()},
-              {"raster", {{"azimuth_bins", s.raster.azimuth_bins}, {"band_min", s.raster.band_min},
-                          {"band_max", s.raster.band_max}, {"row_height", s.raster.row_height},
-                          {"max_range", s.raster.max_range}}},
-              {"metrics", {{"ghost_tolerance", s.metrics.ghost_tolerance}, {"edge_jump", s.metrics.edge_jump}}},
-              {"frames", frames}, {"seed", seed}, {"overrides", o.overrides},
-              {"command", o.command}};
-}
-
-std::string frame_metrics_csv(const eval::RasterMetrics& m, bool scored) {
-  if (!scored) return ",,,,";
-  auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.6f}", v) : std::string(); };
-  return fmt::format("{},{},{},{},{}", num(m.coverage), num(m.rmse), num(m.rmse_off_edges), m.ghosts,
-                     m.estimate_known);
+RunConfig score_config(const ScoreOptions& o, const RunSettings& s, int frames, std::uint64_t seed) {
+  RunConfig c;
+  c.mapper = o.name;
+  c.raster = s.raster;
+  c.metrics = s.metrics;
+  c.frames = frames;
+  c.seed = seed;
+  c.overrides = o.overrides;
+  c.command = o.command;
+  return c;
 }
 
 // What scoring frame by frame gives the summary.
@@ -180,6 +175,34 @@ bool pictured(const std::vector<int>& chosen, int frame, int last) {
   return std::find(chosen.begin(), chosen.end(), frame) != chosen.end();
 }
 
+// frames.csv, circle.csv and (with a cylinder given) cylinder.csv of a scored folder.
+struct ScoreFiles {
+  ResultFile frames, circle;
+  std::optional<ResultFile> cylinder;
+  ScoreFiles(const fs::path& dir, bool with_cylinder) : frames(dir / "frames.csv"), circle(dir / "circle.csv") {
+    frames << frames_csv_header();
+    circle << kCircleCsvHeader;
+    if (with_cylinder) cylinder.emplace(dir / "cylinder.csv"), *cylinder << kCylinderCsvHeader;
+  }
+  void close() {
+    frames.close();
+    circle.close();
+    if (cylinder) cylinder->close();
+  }
+};
+
+// The chosen pictures of one scored frame: the circle beside the truth, and the cylinder.
+void draw_frame(const fs::path& dir, const std::string& scene, const ScoreOptions& o, int i, double time,
+                const Circle& circle, const Cylinder* cylinder, const eval::GroundTruthRasters& truth,
+                const RasterOrigin& origin, const RasterConfig& raster) {
+  const std::string stem = fmt::format("frame_{:06d}", i);
+  plot_circle(dir / "pictures" / (stem + "_circle.png"), circle, &truth.circle, origin, raster,
+              fmt::format("{}: {} circle, frame {} (t = {:.2f} s)", scene, o.name, i, time));
+  if (cylinder)
+    plot_cylinder(dir / "pictures" / (stem + "_cylinder.png"), *cylinder, raster,
+                  fmt::format("{}: {} cylinder, frame {}", scene, o.name, i));
+}
+
 // Per frame of the estimates: the truth at the true pose, the metrics, frames.csv, the rasters
 // beside the truth and the chosen pictures, in `dir`.
 Scores score_frames(const Estimates& estimates, FrameSource& source, const RunSettings& settings,
@@ -188,16 +211,12 @@ Scores score_frames(const Estimates& estimates, FrameSource& source, const RunSe
   const int last = estimates.circle.frames.rbegin()->first;
   const bool pictures = !(o.picture_frames.size() == 1 && o.picture_frames[0] < 0);
   if (pictures) fs::create_directory(dir / "pictures");
-  std::ofstream frames_csv(dir / "frames.csv"), circle_csv(dir / "circle.csv"), cylinder_csv;
-  frames_csv << frames_csv_header();
-  circle_csv << "frame,bin,estimate,truth\n";
-  if (with_cylinder) cylinder_csv.open(dir / "cylinder.csv"), cylinder_csv << "frame,row,bin,estimate,truth\n";
+  ScoreFiles files(dir, with_cylinder);
   Scores scores;
   Progress progress("score " + source.name(), static_cast<long>(estimates.circle.frames.size()), o.quiet);
   for (const auto& [i, cells] : estimates.circle.frames) {
     throw_if_interrupted();
     const SourceFrame sensed = source.frame(i);
-    const Frame& frame = sensed.frame;
     const RasterOrigin origin = raster_origin(sensed.world_T_body_true, source.ground_z());
     Circle circle(settings.raster.azimuth_bins);
     circle.bins = cells;
@@ -205,39 +224,32 @@ Scores score_frames(const Estimates& estimates, FrameSource& source, const RunSe
     Cylinder cylinder = make_cylinder(settings.raster);
     if (with_cylinder) cylinder.cells = estimates.cylinder.frames.at(i);
     // The evaluation `run` uses, without the EDF comparison (no map to trace in).
-    const auto triangles = source.truth(frame.time);
+    const auto triangles = source.truth(sensed.frame.time);
     const eval::FrameEvaluation evaluation = eval::evaluate_frame(
         circle, cylinder, eval::FrameTruth{&*triangles, origin}, nullptr, origin,
         {settings.raster, settings.metrics, settings.edf});
-    const eval::GroundTruthRasters& truth = evaluation.truth;
+    FrameRow row = FrameRow::of(i, sensed.frame.time, sensed.world_T_body_true, evaluation);
+    if (!with_cylinder) row.cylinder.reset();
+    files.frames << frames_csv_row(row);
     scores.circle.push_back(evaluation.circle);
-    if (with_cylinder) scores.cylinder.push_back(evaluation.cylinder);
-    frames_csv << i << ',' << fmt::format("{:.6f}", frame.time) << ',' << pose_csv(sensed.world_T_body_true)
-               << ',' << frame_metrics_csv(scores.circle.back(), true) << ','
-               << frame_metrics_csv(with_cylinder ? scores.cylinder.back() : eval::RasterMetrics{}, with_cylinder)
-               << ",,,,,,,,\n";
-    write_circle_rows(circle_csv, i, circle, truth.circle);
-    if (with_cylinder) write_cylinder_rows(cylinder_csv, i, cylinder, truth.cylinder);
-    if (pictures && pictured(o.picture_frames, i, last)) {
-      const std::string stem = fmt::format("frame_{:06d}", i);
-      plot_circle(dir / "pictures" / (stem + "_circle.png"), circle, &truth.circle, origin, settings.raster,
-                  fmt::format("{}: {} circle, frame {} (t = {:.2f} s)", source.name(), o.name, i, frame.time));
-      if (with_cylinder)
-        plot_cylinder(dir / "pictures" / (stem + "_cylinder.png"), cylinder, settings.raster,
-                      fmt::format("{}: {} cylinder, frame {}", source.name(), o.name, i));
+    write_circle_rows(files.circle.stream(), i, circle, evaluation.truth.circle);
+    if (with_cylinder) {
+      scores.cylinder.push_back(evaluation.cylinder);
+      write_cylinder_rows(files.cylinder->stream(), i, cylinder, evaluation.truth.cylinder);
     }
+    if (pictures && pictured(o.picture_frames, i, last))
+      draw_frame(dir, source.name(), o, i, sensed.frame.time, circle, with_cylinder ? &cylinder : nullptr,
+                 evaluation.truth, origin, settings.raster);
     progress.update(static_cast<long>(scores.circle.size()));
   }
   progress.finish();
-  for (std::ofstream* f : {&frames_csv, &circle_csv, &cylinder_csv})
-    if (f->is_open() && (f->close(), f->fail()))
-      throw std::runtime_error("writing the result files in " + dir.string() + " failed");
+  files.close();
   return scores;
 }
 
 }  // namespace
 
-json score_rasters(const ScoreOptions& o) {
+RunSummary score_rasters(const ScoreOptions& o) {
   RunSettings settings;
   std::vector<std::string> scenario_overrides;
   split_overrides(o.overrides, scenario_overrides, settings);
@@ -263,23 +275,21 @@ json score_rasters(const ScoreOptions& o) {
   const Estimates estimates = read_estimates(circle_file, cylinder_file, settings.raster, frame_count);
   const Scores scores = score_frames(estimates, *source, settings, o, dir);
 
-  const json config = score_config(o, settings, frame_count, source->seed());
-  const json summary{{"schema_version", kResultSchemaVersion},
-                     {"scenario", {{"name", source->name()}, {"file", o.scenario.string()}}},
-                     {"seed", source->seed()},
-                     {"code_version", code_version()},
-                     {"ground_truth", true},
-                     {"ground_truth_note", "exact wedge minima from the scenario's geometry"},
-                     {"config", config},
-                     {"config_hash", config_hash(config)},
-                     {"evaluated_frames", scores.circle.size()},
-                     {"tags", tags_json(o.tags)},
-                     {"scored", {{"circle", o.command.empty() ? o.circle.string() : "external/circle.csv"},
-                                 {"cylinder", cylinder_file.empty() ? json(nullptr)
-                                              : json(o.command.empty() ? o.cylinder.string() : "external/cylinder.csv")}}},
-                     {"metrics", {{"circle", metrics_summary(scores.circle)},
-                                  {"cylinder", metrics_summary(scores.cylinder)}}}};
-  write_text_file(dir / "summary.json", summary.dump(2) + "\n");
+  RunSummary summary;
+  summary.scenario_name = source->name();
+  summary.scenario_file = o.scenario.string();
+  summary.seed = source->seed();
+  summary.code_version = code_version();
+  summary.ground_truth = true;
+  summary.config = score_config(o, settings, frame_count, source->seed());
+  summary.evaluated_frames = static_cast<int>(scores.circle.size());
+  summary.tags = parse_tags(o.tags);
+  const bool external = !o.command.empty();
+  summary.scored = ScoredFiles{external ? "external/circle.csv" : o.circle.string(), std::nullopt};
+  if (!cylinder_file.empty()) summary.scored->cylinder = external ? "external/cylinder.csv" : o.cylinder.string();
+  summary.circle = RasterSummary::of(scores.circle);
+  summary.cylinder = RasterSummary::of(scores.cylinder);
+  write_result_file(dir / "summary.json", json(summary).dump(2) + "\n");
   staged.commit();
   return summary;
 }
@@ -296,13 +306,13 @@ void add_score_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--frames", o->frames, "Number of frames (default: the scenario's)")->check(CLI::PositiveNumber);
   cmd->add_option("--seed", o->seed, "Run seed (overrides the scenario's)");
   cmd->add_option("--set", o->overrides, "key=value: a scenario key or a raster.* / metrics.* run key");
-  cmd->add_option("--name", o->name, "The program's name, recorded as the mapper")->capture_default_str();
+  cmd->add_option("--name", o->name, "The program's name, recorded as the mapper");
   cmd->add_option("--pictures", o->picture_frames, "Frames to draw (default: the last scored; -1: none)");
   cmd->add_option("--tag", o->tags, "key=value label recorded in summary.json");
   cmd->add_option("--command", o->command,
                   "External mapper to run first (no shell): {sequence} (a TUM RGB-D directory), {out} "
                   "(where it writes circle.csv, optionally cylinder.csv), {frames}");
-  cmd->add_option("--timeout", o->timeout, "Time limit of --command, seconds")->capture_default_str();
+  cmd->add_option("--timeout", o->timeout, "Time limit of --command, seconds");
   cmd->add_option("--sequence-cache", o->sequence_cache,
                   "Where --command's rendered sequences are kept (default: beside --out)");
   cmd->callback([o, &global] {
@@ -311,12 +321,12 @@ void add_score_command(CLI::App& app, const GlobalOptions& global) {
       throw InputError("score: give either --circle (and optionally --cylinder) or --command");
     if (!o->command.empty() && o->sequence_cache.empty()) o->sequence_cache = o->out.parent_path() / "sequences";
     install_interrupt_handler();
-    const json summary = score_rasters(*o);
+    const RunSummary summary = score_rasters(*o);
     if (!global.quiet) {
-      const json& m = summary["metrics"]["circle"]["mean"];
+      const MeanMetrics& m = summary.circle.mean;
       std::printf("score: %s, %d frames; circle mean coverage %s, mean RMSE %s m\n  results: %s\n",
-                  summary["scenario"]["name"].get<std::string>().c_str(), summary["evaluated_frames"].get<int>(),
-                  m["coverage"].dump().c_str(), m["rmse"].dump().c_str(), o->out.string().c_str());
+                  summary.scenario_name.c_str(), summary.evaluated_frames, json(m.coverage).dump().c_str(),
+                  json(m.rmse).dump().c_str(), o->out.string().c_str());
     }
   });
 }

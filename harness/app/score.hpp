@@ -12,8 +12,7 @@
 #pragma once
 
 #include "harness/app/cli.hpp"
-
-#include <nlohmann/json.hpp>
+#include "harness/formats/run_summary.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -43,7 +42,7 @@ struct ScoreOptions {
 };
 
 // Scores the estimates and writes the result directory (atomically). Returns its summary.
-nlohmann::json score_rasters(const ScoreOptions& options);
+RunSummary score_rasters(const ScoreOptions& options);
 
 void add_score_command(CLI::App& app, const GlobalOptions& global);
 

@@ -5,6 +5,7 @@
 #include "harness/formats/wav_io.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/fields.hpp"
+#include "harness/support/interrupt.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
 
@@ -24,8 +25,7 @@ fs::path default_hrir_file() { return "/usr/share/libmysofa/default.sofa"; }
 static const CLI::Range kPositionRange(-kMaxPosition, kMaxPosition);
 
 void add_room_options(CLI::App& cmd, RoomOptions& o) {
-  cmd.add_option("--room", o.room, "Shoebox room LxWxH in metres (corner at the origin)")
-      ->capture_default_str();
+  cmd.add_option("--room", o.room, "Shoebox room LxWxH in metres (corner at the origin)");
   cmd.add_option("--room-min", o.room_min, "Room corner x,y,z (with --room-max; e.g. a map's box)")
       ->delimiter(',')->expected(3)->check(kPositionRange);
   cmd.add_option("--room-max", o.room_max, "Opposite room corner x,y,z")
@@ -33,15 +33,13 @@ void add_room_options(CLI::App& cmd, RoomOptions& o) {
   cmd.add_option("--listener", o.listener, "Head position x,y,z (default: room centre, 1.5 m high)")
       ->delimiter(',')->expected(3)->check(kPositionRange);
   cmd.add_option("--heading", o.heading_deg, "Direction the listener faces, degrees from +x")
-      ->check(CLI::Range(-3600.0, 3600.0))->capture_default_str();
-  cmd.add_option("--rt60", o.rt60, "Reverberation time, seconds")->capture_default_str();
-  cmd.add_option("--order", o.order, "Image-source reflection order")->capture_default_str();
-  cmd.add_option("--ir-length", o.length_s, "BRIR length, seconds (0: the RT60)")
-      ->capture_default_str();
+      ->check(CLI::Range(-3600.0, 3600.0));
+  cmd.add_option("--rt60", o.rt60, "Reverberation time, seconds");
+  cmd.add_option("--order", o.order, "Image-source reflection order");
+  cmd.add_option("--ir-length", o.length_s, "BRIR length, seconds (0: the RT60)");
   cmd.add_option("--seed", o.seed, "Seed of the late-tail noise")
-      ->check(CLI::Range(0ull, static_cast<unsigned long long>(kMaxSeed)))->capture_default_str();
-  cmd.add_option("--hrir", o.hrir_file, "HRIR set (SOFA) the BRIRs are built from")
-      ->capture_default_str();
+      ->check(CLI::Range(0ull, static_cast<unsigned long long>(kMaxSeed)));
+  cmd.add_option("--hrir", o.hrir_file, "HRIR set (SOFA) the BRIRs are built from");
 }
 
 // A room side in metres: a number in (0, kMaxPosition].
@@ -115,11 +113,15 @@ audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::pa
   std::vector<audio::BinauralIr> irs(na * grid.distances_m.size());
   Progress progress("BRIRs", static_cast<long>(irs.size()), quiet);
   std::atomic<long> done{0};
+  // A signal stops the synthesis within one grid point's work (the rest are skipped).
+  install_interrupt_handler();
   // Each grid point in its own slot: the set does not depend on the thread count.
   tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
+    if (interrupt_requested()) return;
     irs[i] = synth.synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
     ++done;
   });
+  throw_if_interrupted();
   progress.update(done);
   progress.finish();
   audio::BrirSet set(room.sample_rate, grid, std::move(irs));
@@ -136,40 +138,29 @@ void add_sonify_options(CLI::App& cmd, SonifySetup& s) {
       ->transform(CLI::CheckedTransformer(
           std::map<std::string, audio::SweepMode>{{"ranging", audio::SweepMode::Ranging},
                                                   {"objects", audio::SweepMode::Objects}}));
-  cmd.add_option("--period", w.period_s, "Seconds per sweep (36 sectors)")->capture_default_str();
+  cmd.add_option("--period", w.period_s, "Seconds per sweep (36 sectors)");
   cmd.add_option("--sector-onsets", w.sector_onsets_s,
                  "Onset of each sector, seconds (36 increasing values, comma separated)")
       ->delimiter(',');
-  cmd.add_option("--scale", w.environment_scale, "Range x scale -> BRIR distance")
-      ->capture_default_str();
-  cmd.add_option("--fov-centre", w.filter.fov_centre_deg, "Field of view centre, degrees")
-      ->capture_default_str();
-  cmd.add_option("--fov-width", w.filter.fov_width_deg, "Field of view width, degrees")
-      ->capture_default_str();
+  cmd.add_option("--scale", w.environment_scale, "Range x scale -> BRIR distance");
+  cmd.add_option("--fov-centre", w.filter.fov_centre_deg, "Field of view centre, degrees");
+  cmd.add_option("--fov-width", w.filter.fov_width_deg, "Field of view width, degrees");
   cmd.add_option("--min-range", w.filter.min_range_m, "Play only ranges >= this, metres")
       ->check(CLI::Range(0.0, kMaxRange));
   cmd.add_option("--max-range", w.filter.max_range_m, "Play only ranges <= this, metres")
       ->check(CLI::Range(0.0, kMaxRange));
-  cmd.add_option("--max-taps", w.filter.max_taps, "Ranging: only the N nearest taps (0: all)")
-      ->capture_default_str();
-  cmd.add_option("--max-objects", w.max_objects, "Objects: the N nearest pseudo-objects")
-      ->capture_default_str();
+  cmd.add_option("--max-taps", w.filter.max_taps, "Ranging: only the N nearest taps (0: all)");
+  cmd.add_option("--max-objects", w.max_objects, "Objects: the N nearest pseudo-objects");
   cmd.add_option("--object-jump", w.object_jump_m_per_deg,
-                 "Objects: split where the range jumps more than this, metres per degree")
-      ->capture_default_str();
-  cmd.add_option("--near-below", w.pitch.near_below_m, "Near taps: BRIR distance below, metres")
-      ->capture_default_str();
-  cmd.add_option("--near-shift", w.pitch.near_semitones, "Near taps: pitch shift, semitones")
-      ->capture_default_str();
-  cmd.add_option("--far-above", w.pitch.far_above_m, "Far taps: BRIR distance above, metres")
-      ->capture_default_str();
-  cmd.add_option("--far-shift", w.pitch.far_semitones, "Far taps: pitch shift, semitones")
-      ->capture_default_str();
+                 "Objects: split where the range jumps more than this, metres per degree");
+  cmd.add_option("--near-below", w.pitch.near_below_m, "Near taps: BRIR distance below, metres");
+  cmd.add_option("--near-shift", w.pitch.near_semitones, "Near taps: pitch shift, semitones");
+  cmd.add_option("--far-above", w.pitch.far_above_m, "Far taps: BRIR distance above, metres");
+  cmd.add_option("--far-shift", w.pitch.far_semitones, "Far taps: pitch shift, semitones");
   cmd.add_flag("--invert-pitch", w.pitch.inverted, "Near higher, far lower (parking sensor)");
   cmd.add_flag("!--no-woosh", w.woosh_unknown, "Unknown sectors stay silent");
   cmd.add_option("--loudness", w.loudness.target_lufs,
-                 "Integrated loudness target, LUFS (EBU R128); the -1 dBTP true-peak ceiling wins")
-      ->capture_default_str();
+                 "Integrated loudness target, LUFS (EBU R128); the -1 dBTP true-peak ceiling wins");
   cmd.add_option("--level", w.level,
                  "per-file: each WAV normalised to --loudness; fixed: one gain for every sweep, "
                  "set by the loudest sweep the BRIRs can play (levels compare across sweeps)")
@@ -253,13 +244,7 @@ void write_sweep(const audio::SweepAudio& audio, const fs::path& wav) {
   StagedFile wav_file(wav, is_sonomap_sweep);
   StagedFile events_file(events_path_for(wav), is_sonomap_sweep);
   write_wav(wav_file.path(), audio.sample_rate, audio.left, audio.right);
-  {
-    std::FILE* f = std::fopen(events_file.path().c_str(), "wb");
-    if (!f) throw std::runtime_error("cannot write " + events_file.path().string());
-    const std::string text = sweep_events_csv(audio);
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (std::fclose(f) != 0 || !ok) throw std::runtime_error("cannot write " + events_file.path().string());
-  }
+  events_file.write(sweep_events_csv(audio));
   events_file.commit();
   wav_file.commit();
 }

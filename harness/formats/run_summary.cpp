@@ -152,22 +152,23 @@ std::string config_hash(const json& config) {
 
 std::string config_hash(const RunConfig& config) { return config_hash(json(config)); }
 
-json metrics_json(const eval::RasterMetrics& m) { return metrics_json_of(m); }
-json raster_summary_json(const RasterSummary& r) { return raster_summary_json_of(r); }
-
 void to_json(json& j, const RunConfig& c) {
-  const EdfRasterConfig& t = c.edf.trace;
   j = json{{"mapper", c.mapper}, {"mapper_config", json(c.mapper_config)},
            {"raster", {{"azimuth_bins", c.raster.azimuth_bins}, {"band_min", c.raster.band_min},
                        {"band_max", c.raster.band_max}, {"row_height", c.raster.row_height},
                        {"max_range", c.raster.max_range}}},
            {"metrics", {{"ghost_tolerance", c.metrics.ghost_tolerance},
                         {"edge_jump", c.metrics.edge_jump}}},
-           {"edf", {{"enabled", c.edf.enabled}, {"every", c.edf.every},
-                    {"sample_radius", t.sample_radius}, {"hit_tolerance", t.hit_tolerance},
-                    {"max_steps", t.max_steps}, {"max_range", t.max_range},
-                    {"trace_rows", c.edf.trace_rows}, {"trace_heights", t.trace_heights}}},
-           {"frames", c.frames}, {"every", c.every}, {"seed", c.seed}, {"overrides", c.overrides}};
+           {"frames", c.frames}, {"seed", c.seed}, {"overrides", c.overrides}};
+  if (c.edf) {
+    const EdfRasterConfig& t = c.edf->trace;
+    j["edf"] = {{"enabled", c.edf->enabled}, {"every", c.edf->every},
+                {"sample_radius", t.sample_radius}, {"hit_tolerance", t.hit_tolerance},
+                {"max_steps", t.max_steps}, {"max_range", t.max_range},
+                {"trace_rows", c.edf->trace_rows}, {"trace_heights", t.trace_heights}};
+  }
+  if (c.every) j["every"] = *c.every;
+  if (c.command) j["command"] = *c.command;
 }
 
 void from_json(const json& j, RunConfig& c) {
@@ -181,19 +182,23 @@ void from_json(const json& j, RunConfig& c) {
   r.at("max_range").get_to(c.raster.max_range);
   j.at("metrics").at("ghost_tolerance").get_to(c.metrics.ghost_tolerance);
   j.at("metrics").at("edge_jump").get_to(c.metrics.edge_jump);
-  const json& e = j.at("edf");
-  e.at("enabled").get_to(c.edf.enabled);
-  e.at("every").get_to(c.edf.every);
-  e.at("trace_rows").get_to(c.edf.trace_rows);
-  e.at("sample_radius").get_to(c.edf.trace.sample_radius);
-  e.at("hit_tolerance").get_to(c.edf.trace.hit_tolerance);
-  e.at("max_steps").get_to(c.edf.trace.max_steps);
-  e.at("max_range").get_to(c.edf.trace.max_range);
-  e.at("trace_heights").get_to(c.edf.trace.trace_heights);
+  if (j.contains("edf")) {
+    const json& e = j.at("edf");
+    EdfSettings& edf = c.edf.emplace();
+    e.at("enabled").get_to(edf.enabled);
+    e.at("every").get_to(edf.every);
+    e.at("trace_rows").get_to(edf.trace_rows);
+    e.at("sample_radius").get_to(edf.trace.sample_radius);
+    e.at("hit_tolerance").get_to(edf.trace.hit_tolerance);
+    e.at("max_steps").get_to(edf.trace.max_steps);
+    e.at("max_range").get_to(edf.trace.max_range);
+    e.at("trace_heights").get_to(edf.trace.trace_heights);
+  }
   j.at("frames").get_to(c.frames);
-  j.at("every").get_to(c.every);
+  if (j.contains("every")) c.every = j.at("every").get<int>();
   j.at("seed").get_to(c.seed);
   j.at("overrides").get_to(c.overrides);
+  if (j.contains("command")) c.command = j.at("command").get<std::string>();
 }
 
 void to_json(json& j, const RunSummary& s) {
@@ -213,6 +218,9 @@ void to_json(json& j, const RunSummary& s) {
                         {"cylinder", raster_summary_json_of(s.cylinder)}}}};
   if (s.edf_circle) j["metrics"]["edf_circle"] = raster_summary_json_of(*s.edf_circle);
   if (s.edf) j["edf"] = edf_summary_json(*s.edf);
+  if (s.scored)
+    j["scored"] = {{"circle", s.scored->circle},
+                   {"cylinder", s.scored->cylinder ? json(*s.scored->cylinder) : json(nullptr)}};
   j["sweeps"] = json::array();
   for (const SweepLevel& l : s.sweeps)
     j["sweeps"].push_back({{"file", l.file}, {"gain_db", l.gain_db}, {"loudness_lufs", l.loudness_lufs},
@@ -248,6 +256,11 @@ void from_json(const json& j, RunSummary& s) {
   s.cylinder = raster_summary_of(m.at("cylinder"));
   if (m.contains("edf_circle")) s.edf_circle = raster_summary_of(m.at("edf_circle"));
   if (j.contains("edf")) s.edf = edf_summary_of(j.at("edf"));
+  if (j.contains("scored")) {
+    ScoredFiles& f = s.scored.emplace();
+    j.at("scored").at("circle").get_to(f.circle);
+    if (const json& c = j.at("scored").at("cylinder"); !c.is_null()) f.cylinder = c.get<std::string>();
+  }
   for (const json& l : j.value("sweeps", json::array()))
     s.sweeps.push_back({l.at("file").get<std::string>(), l.at("gain_db").get<double>(),
                         number_of(l.at("loudness_lufs")), number_of(l.at("true_peak_dbtp")),

@@ -52,17 +52,26 @@ struct EdfSettings {
   EdfRasterConfig trace;
 };
 
-// Everything that decides a run's numbers; config_hash is taken over its JSON.
+// Everything that decides a run's numbers; config_hash is taken over its JSON. `score` (which
+// runs no mapper and no EDF comparison, every frame it is given) records no edf or every and
+// adds the command it ran.
 struct RunConfig {
   std::string mapper;
   std::map<std::string, std::string> mapper_config;  // as the mapper reports it (text)
   RasterConfig raster;
   eval::MetricsConfig metrics;
-  EdfSettings edf;
+  std::optional<EdfSettings> edf;  // run only
   int frames = 0;
-  int every = 1;
+  std::optional<int> every;  // run only
   std::uint64_t seed = 0;
   std::vector<std::string> overrides;
+  std::optional<std::string> command;  // score only: the external mapper's command ("" if none)
+};
+
+// The estimate files `score` scored, as given (or inside the result for --command).
+struct ScoredFiles {
+  std::string circle;
+  std::optional<std::string> cylinder;  // null: no cylinder given
 };
 
 // One sweep written: the one gain applied and the loudness measured (summary.json "sweeps").
@@ -101,6 +110,7 @@ struct RunSummary {
   std::optional<EdfSummary> edf;            // with the EDF comparison on
   std::vector<SweepLevel> sweeps;
   std::optional<ListenSummary> listen;
+  std::optional<ScoredFiles> scored;  // score only
 };
 
 // timings.json: per stage, the median wall time over the frames it ran in.
@@ -114,11 +124,6 @@ RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples)
 // FNV-1a over the canonical JSON of a configuration: a short, stable hash.
 std::string config_hash(const nlohmann::json& config);
 std::string config_hash(const RunConfig& config);
-
-// One frame's metrics and one raster's summary as summary.json holds them (NaN -> null), for
-// result directories written without a whole RunSummary at hand.
-nlohmann::json metrics_json(const eval::RasterMetrics& m);
-nlohmann::json raster_summary_json(const RasterSummary& r);
 
 void to_json(nlohmann::json& j, const RunConfig& c);
 void from_json(const nlohmann::json& j, RunConfig& c);

@@ -188,76 +188,52 @@ audio::HrirSet read_hrir_set(const fs::path& file, double output_rate) {
   return set;
 }
 
-audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate,
-                                   const std::vector<double>& required) {
-  std::error_code ec;
-  if (!fs::is_directory(directory, ec)) bad(directory, "not a directory");
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(directory, ec))
-    if (entry.path().extension() == ".sofa") files.push_back(entry.path());
-  if (ec) bad(directory, "cannot list: " + ec.message());
-  if (files.empty()) bad(directory, "no .sofa files (expected one BRIR file per distance)");
-  std::sort(files.begin(), files.end());
+namespace {
 
-  struct Layer {
-    double distance;
-    std::vector<audio::BinauralIr> irs;  // in the order of `azimuths`
-  };
-  std::vector<double> azimuths;  // from the first file
-  std::vector<Layer> layers;
-  double rate = 0.0;
-  fs::path rate_file;
-  size_t length = 0;
-  for (const fs::path& file : files) {
-    SofaContents sofa = read_sofa(file);
-    if (rate == 0.0) {
-      rate = sofa.sample_rate;
-      rate_file = file;
-    } else if (std::abs(sofa.sample_rate - rate) > 1e-6) {
-      bad(file, "sample rate " + std::to_string(sofa.sample_rate) + " Hz differs from " +
-                    std::to_string(rate) + " Hz of " + rate_file.filename().string());
-    }
-    Layer layer{-1.0, {}};
-    std::vector<double> file_azimuths;
-    for (size_t i = 0; i < sofa.irs.size(); ++i) {
-      const Eigen::Vector3d& p = sofa.source_positions[i];
-      const double horizontal = p.head<2>().norm();
-      const double elevation = std::atan2(p.z(), horizontal) * 180.0 / kPi;
-      if (std::abs(elevation) >= 1.0) continue;
-      const double distance = p.norm();
-      if (layer.distance < 0.0) layer.distance = distance;
-      if (std::abs(distance - layer.distance) > 0.01)
-        bad(file, "holds several distances (" + std::to_string(layer.distance) + " and " +
-                      std::to_string(distance) + " m); write one file per distance");
-      file_azimuths.push_back(std::atan2(p.y(), p.x()) * 180.0 / kPi);
-      layer.irs.push_back(sofa.irs[i]);
-    }
-    if (layer.irs.empty()) bad(file, "no measurement on the horizontal plane");
-    if (azimuths.empty()) {
-      azimuths = file_azimuths;
-    } else {
-      // Same azimuths as the first file, reordered to its order.
-      if (file_azimuths.size() != azimuths.size())
-        bad(file, std::to_string(file_azimuths.size()) + " horizontal azimuths, the first file has " +
-                      std::to_string(azimuths.size()));
-      std::vector<audio::BinauralIr> ordered;
-      for (double a : azimuths) {
-        size_t j = 0;
-        while (j < file_azimuths.size() &&
-               std::abs(audio::wrap_degrees_180(file_azimuths[j] - a)) > 0.01)
-          ++j;
-        if (j == file_azimuths.size())
-          bad(file, "has no measurement at azimuth " + std::to_string(a) + " degrees");
-        ordered.push_back(std::move(layer.irs[j]));
-      }
-      layer.irs = std::move(ordered);
-    }
-    for (const auto& other : layers)
-      if (std::abs(other.distance - layer.distance) < 0.01)
-        bad(file, "a second file for distance " + std::to_string(layer.distance) + " m");
-    length = std::max(length, layer.irs.front().left.size());
-    layers.push_back(std::move(layer));
+// One BRIR file's measurements on the horizontal plane (one distance), by azimuth.
+struct Layer {
+  double distance = -1.0;
+  std::vector<double> azimuths;
+  std::vector<audio::BinauralIr> irs;  // in the order of `azimuths`
+};
+
+Layer horizontal_layer(const fs::path& file, const SofaContents& sofa) {
+  Layer layer;
+  for (size_t i = 0; i < sofa.irs.size(); ++i) {
+    const Eigen::Vector3d& p = sofa.source_positions[i];
+    const double horizontal = p.head<2>().norm();
+    const double elevation = std::atan2(p.z(), horizontal) * 180.0 / kPi;
+    if (std::abs(elevation) >= 1.0) continue;
+    const double distance = p.norm();
+    if (layer.distance < 0.0) layer.distance = distance;
+    if (std::abs(distance - layer.distance) > 0.01)
+      bad(file, "holds several distances (" + std::to_string(layer.distance) + " and " +
+                    std::to_string(distance) + " m); write one file per distance");
+    layer.azimuths.push_back(std::atan2(p.y(), p.x()) * 180.0 / kPi);
+    layer.irs.push_back(sofa.irs[i]);
   }
+  if (layer.irs.empty()) bad(file, "no measurement on the horizontal plane");
+  return layer;
+}
+
+// The layer's responses reordered to `azimuths` (the first file's); the same azimuths or bad input.
+void reorder_to(Layer& layer, const std::vector<double>& azimuths, const fs::path& file) {
+  if (layer.azimuths.size() != azimuths.size())
+    bad(file, std::to_string(layer.azimuths.size()) + " horizontal azimuths, the first file has " +
+                  std::to_string(azimuths.size()));
+  std::vector<audio::BinauralIr> ordered;
+  for (double a : azimuths) {
+    size_t j = 0;
+    while (j < layer.azimuths.size() && std::abs(audio::wrap_degrees_180(layer.azimuths[j] - a)) > 0.01) ++j;
+    if (j == layer.azimuths.size()) bad(file, "has no measurement at azimuth " + std::to_string(a) + " degrees");
+    ordered.push_back(std::move(layer.irs[j]));
+  }
+  layer.irs = std::move(ordered);
+  layer.azimuths = azimuths;
+}
+
+void check_distances(const fs::path& directory, const std::vector<Layer>& layers,
+                     const std::vector<double>& required) {
   for (double d : required) {
     const bool found = std::any_of(layers.begin(), layers.end(),
                                    [&](const Layer& l) { return std::abs(l.distance - d) < 0.01; });
@@ -267,10 +243,15 @@ audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate
       bad(directory, "missing BRIRs for distance " + std::to_string(d) + " m (have: " + have + ")");
     }
   }
-  std::sort(layers.begin(), layers.end(),
-            [](const Layer& a, const Layer& b) { return a.distance < b.distance; });
+}
+
+// The layers as one set at `output_rate`, nearest first, every response padded to the longest.
+audio::BrirSet assemble(const fs::path& directory, std::vector<Layer> layers, double rate, double output_rate) {
+  std::sort(layers.begin(), layers.end(), [](const Layer& a, const Layer& b) { return a.distance < b.distance; });
+  size_t length = 0;
+  for (const auto& layer : layers) length = std::max(length, layer.irs.front().left.size());
   audio::BrirGrid grid;
-  grid.azimuths_deg = azimuths;
+  grid.azimuths_deg = layers.front().azimuths;
   std::vector<audio::BinauralIr> irs;
   const double ratio = output_rate / rate;
   for (auto& layer : layers) {
@@ -286,6 +267,38 @@ audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate
   } catch (const std::invalid_argument& e) {
     bad(directory, e.what());
   }
+}
+
+}  // namespace
+
+audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate,
+                                   const std::vector<double>& required) {
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) bad(directory, "not a directory");
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(directory, ec))
+    if (entry.path().extension() == ".sofa") files.push_back(entry.path());
+  if (ec) bad(directory, "cannot list: " + ec.message());
+  if (files.empty()) bad(directory, "no .sofa files (expected one BRIR file per distance)");
+  std::sort(files.begin(), files.end());
+
+  std::vector<Layer> layers;
+  double rate = 0.0;
+  for (const fs::path& file : files) {
+    const SofaContents sofa = read_sofa(file);
+    if (rate == 0.0) rate = sofa.sample_rate;
+    else if (std::abs(sofa.sample_rate - rate) > 1e-6)
+      bad(file, "sample rate " + std::to_string(sofa.sample_rate) + " Hz differs from " +
+                    std::to_string(rate) + " Hz of " + files.front().filename().string());
+    Layer layer = horizontal_layer(file, sofa);
+    if (!layers.empty()) reorder_to(layer, layers.front().azimuths, file);
+    for (const auto& other : layers)
+      if (std::abs(other.distance - layer.distance) < 0.01)
+        bad(file, "a second file for distance " + std::to_string(layer.distance) + " m");
+    layers.push_back(std::move(layer));
+  }
+  check_distances(directory, layers, required);
+  return assemble(directory, std::move(layers), rate, output_rate);
 }
 
 // ---------------------------------------------------------------------------------------------

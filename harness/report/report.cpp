@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "harness/report/claims.hpp"
 #include "harness/report/report.hpp"
+
+#include "harness/report/claims.hpp"
+#include "harness/formats/run_summary.hpp"
 
 #include "harness/report/pictures.hpp"
 #include "harness/report/rollup.hpp"
@@ -9,7 +11,6 @@
 #include "harness/support/output.hpp"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,6 @@
 #include <sstream>
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace sonomap::harness {
 namespace {
@@ -28,65 +28,55 @@ namespace {
 struct RunRecord {
   std::string id;
   fs::path dir;
-  json summary;
-  json timings;
+  RunSummary summary;
+  RunTimings timings;
+  std::vector<std::pair<std::string, std::string>> metrics;  // rollup.csv's names and cells
   std::string scenario, variant, mapper;
   double voxel = NAN;
-  std::uint64_t seed = 0;
 };
 
-std::string tag(const json& summary, const char* key, const std::string& fallback) {
-  const json& tags = summary.value("tags", json::object());
-  return tags.contains(key) ? tags[key].get<std::string>() : fallback;
+std::string tag(const RunSummary& summary, const char* key, const std::string& fallback) {
+  const auto it = summary.tags.find(key);
+  return it == summary.tags.end() ? fallback : it->second;
+}
+
+RunRecord read_run(const fs::path& dir) {
+  RunRecord r;
+  r.id = dir.filename().string();
+  r.dir = dir;
+  r.summary = read_run_summary(dir);
+  r.timings = read_run_timings(dir);
+  r.metrics = summary_metrics(r.summary);
+  r.mapper = r.summary.config.mapper;
+  r.scenario = tag(r.summary, "scenario", r.summary.scenario_name);
+  r.variant = tag(r.summary, "variant", r.mapper);
+  const auto& mc = r.summary.config.mapper_config;
+  for (const char* key : {"global_voxel", "voxel"})
+    if (const auto it = mc.find(key); it != mc.end()) r.voxel = std::stod(it->second);
+  return r;
 }
 
 std::vector<RunRecord> read_runs(const fs::path& dir) {
   std::vector<RunRecord> runs;
   const fs::path runs_dir = dir / "runs";
   if (!fs::is_directory(runs_dir)) return runs;
-  for (const auto& entry : fs::directory_iterator(runs_dir)) {
-    const fs::path summary_path = entry.path() / "summary.json";
-    if (!entry.is_directory() || !fs::is_regular_file(summary_path)) continue;
-    RunRecord r;
-    r.id = entry.path().filename().string();
-    r.dir = entry.path();
-    try {
-      std::ifstream in(summary_path);
-      r.summary = json::parse(in);
-      std::ifstream tin(entry.path() / "timings.json");
-      r.timings = tin ? json::parse(tin) : json::object();
-    } catch (const json::exception& e) {
-      throw InputError(summary_path.string() + ": not a sonomap summary: " + e.what());
-    }
-    const json& config = r.summary["config"];
-    r.mapper = config.value("mapper", "?");
-    r.scenario = tag(r.summary, "scenario", r.summary["scenario"].value("name", "?"));
-    r.variant = tag(r.summary, "variant", r.mapper);
-    r.seed = r.summary.value("seed", std::uint64_t{0});
-    const json& mc = config.value("mapper_config", json::object());
-    for (const char* key : {"global_voxel", "voxel"})
-      if (mc.contains(key)) r.voxel = std::stod(mc[key].get<std::string>());
-    runs.push_back(std::move(r));
-  }
+  for (const auto& entry : fs::directory_iterator(runs_dir))
+    if (entry.is_directory() && fs::is_regular_file(entry.path() / "summary.json"))
+      runs.push_back(read_run(entry.path()));
   std::sort(runs.begin(), runs.end(), [](const RunRecord& a, const RunRecord& b) { return a.id < b.id; });
   return runs;
 }
 
-std::string number(const json& v, const char* format = "{:.6g}") {
-  return v.is_number() ? fmt::format(fmt::runtime(format), v.get<double>()) : "";
-}
-
-const json& metric(const RunRecord& r, const char* raster, const char* which) {
-  static const json null;
-  // Runs without a raster (edf_circle before the EDF comparison, or with edf.enabled=false).
-  if (!r.summary.contains("metrics") || !r.summary["metrics"].contains(raster)) return null;
-  const json& m = r.summary["metrics"][raster];
-  return m.contains(which) && !m[which].is_null() ? m[which] : null;
+// A metric of rollup.csv as its cell text ("" when undefined or absent).
+const std::string& metric(const RunRecord& r, const std::string& name) {
+  static const std::string none;
+  for (const auto& [key, cell] : r.metrics)
+    if (key == name) return cell;
+  return none;
 }
 
 std::string value(const RunRecord& r, const char* raster, const char* which, const char* name) {
-  const json& m = metric(r, raster, which);
-  return m.is_object() && m.contains(name) ? number(m[name]) : "";
+  return metric(r, fmt::format("{}_{}_{}", raster, which, name));
 }
 
 // Table cells: coverage in percent, RMSE in metres, "-" when undefined.
@@ -99,22 +89,28 @@ std::string rmse_cell(const RunRecord& r, const char* raster, const char* which)
   return v.empty() ? std::string("-") : fmt::format("{:.3f}", std::stod(v));
 }
 
-// The EDF's bearing slip (summary "edf"."slip"), `which` = final or mean; "" when absent.
+// "final / mean" of a table cell (coverage_cell or rmse_cell).
+template <typename Cell>
+std::string final_and_mean(const RunRecord& r, const char* raster, Cell cell) {
+  return cell(r, raster, "final") + " / " + cell(r, raster, "mean");
+}
+
+// The EDF's bearing slip, `which` = final or mean; "-" when absent.
 std::string slip(const RunRecord& r, const char* which, const char* name) {
-  if (!r.summary.contains("edf") || !r.summary["edf"].is_object()) return "";
-  const json s = r.summary["edf"].value("slip", json::object());
-  return s.contains(which) && s[which].is_object() && s[which].contains(name) ? number(s[which][name], "{:.2f}") : "";
+  const std::string& v = metric(r, fmt::format("edf_slip_{}_{}", which, name));
+  return v.empty() ? std::string("-") : v;
 }
 
 std::vector<std::string> stage_names(const std::vector<RunRecord>& runs) {
   std::set<std::string> names;
   for (const auto& r : runs)
-    for (const auto& item : r.timings.items()) names.insert(item.key());
+    for (const auto& [name, timing] : r.timings) names.insert(name);
   return {names.begin(), names.end()};
 }
 
 std::string median(const RunRecord& r, const std::string& stage) {
-  return r.timings.contains(stage) ? number(r.timings[stage]["median_ms"], "{:.3f}") : "";
+  const auto it = r.timings.find(stage);
+  return it == r.timings.end() ? "" : fmt::format("{:.3f}", it->second.median_ms);
 }
 
 // Whether a column of a run's frames.csv has a value in any row (a scored program's cylinder,
@@ -146,7 +142,7 @@ void plot_over_frames(const fs::path& png, std::vector<const RunRecord*> runs,
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const fs::path csv = runs[i]->dir / "frames.csv";
     gp << (i ? ", \\\n     " : "") << "'" << csv.string() << "' using 'frame':'" << column
-       << "' with lines lw 2 title '" << runs[i]->variant << " s" << runs[i]->seed << "'";
+       << "' with lines lw 2 title '" << runs[i]->variant << " s" << runs[i]->summary.seed << "'";
   }
   gp << "\n";
   draw_with_gnuplot(png, gp.str());
@@ -170,8 +166,8 @@ void plot_time_vs_voxel(const fs::path& png, const std::vector<const RunRecord*>
     for (const std::string& stage : stages) {
       std::string data;
       for (const RunRecord* r : list)
-        if (r->timings.contains(stage))
-          data += fmt::format("{} {}\n", r->voxel, r->timings[stage]["median_ms"].get<double>());
+        if (const auto it = r->timings.find(stage); it != r->timings.end())
+          data += fmt::format("{} {}\n", r->voxel, it->second.median_ms);
       if (data.empty()) continue;
       gp << "$d" << block << " << EOD\n" << data << "EOD\n";
       plots.push_back(fmt::format("$d{} using 1:2 with linespoints lw 2 title '{} {}'", block, mapper, stage));
@@ -185,103 +181,118 @@ void plot_time_vs_voxel(const fs::path& png, const std::vector<const RunRecord*>
   draw_with_gnuplot(png, gp.str());
 }
 
+// rollup.csv: one row per run.
+std::string rollup_csv(const std::vector<RunRecord>& runs, const std::vector<std::string>& stages) {
+  std::ostringstream csv;
+  csv << "run,scenario,variant,mapper,voxel,seed,frames";
+  for (const auto& [name, unused] : summary_metrics(RunSummary{})) csv << ',' << name;
+  for (const auto& s : stages) csv << ",median_" << s << "_ms";
+  csv << '\n';
+  for (const RunRecord& r : runs) {
+    csv << r.id << ',' << r.scenario << ',' << r.variant << ',' << r.mapper << ','
+        << (std::isfinite(r.voxel) ? fmt::format("{}", r.voxel) : "") << ',' << r.summary.seed << ','
+        << r.summary.config.frames;
+    for (const auto& [name, cell] : r.metrics) csv << ',' << cell;
+    for (const auto& s : stages) csv << ',' << median(r, s);
+    csv << '\n';
+  }
+  return csv.str();
+}
+
+// A scenario's table of runs: coverage, RMSE and ghosts of both rasters, integrate time.
+std::string runs_table(const std::vector<const RunRecord*>& list) {
+  std::ostringstream md;
+  md << "| run | mapper | voxel | circle cov. (final / mean) | circle RMSE (final / mean) | "
+        "circle ghosts (final) | cylinder cov. (final / mean) | cylinder RMSE (final / mean) | "
+        "cylinder ghosts (final) | integrate ms (median) |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const RunRecord* r : list)
+    md << "| " << r->id << " | " << r->mapper << " | "
+       << (std::isfinite(r->voxel) ? fmt::format("{}", r->voxel) : "-") << " | "
+       << final_and_mean(*r, "circle", coverage_cell) << " | " << final_and_mean(*r, "circle", rmse_cell)
+       << " | " << value(*r, "circle", "final", "ghosts") << " | " << final_and_mean(*r, "cylinder", coverage_cell)
+       << " | " << final_and_mean(*r, "cylinder", rmse_cell) << " | " << value(*r, "cylinder", "final", "ghosts")
+       << " | " << median(*r, "integrate") << " |\n";
+  return md.str() + "\n";
+}
+
+// The paper's "Compare to EDF": the field's direction to the closest surface against each
+// bin's bearing, and the circle the EDF gives by sphere tracing, beside the map's circle.
+std::string edf_table(const std::vector<const RunRecord*>& list) {
+  std::ostringstream md;
+  md << "### Compare to EDF\n\n"
+     << "Bearing slip: angle between the direction to the closest surface (the EDF's "
+        "-gradient at the bin's point on the sample circle) and the bin's ray, degrees, over "
+        "the bins where the field is observed. EDF circle: ranges sphere-traced in the field "
+        "along each bin's ray at the sensor's height.\n\n"
+     << "| run | mapper | slip median / p90 (final) | slip median / p90 (mean) | "
+        "EDF circle cov. (final / mean) | EDF circle RMSE (final / mean) | "
+        "map circle cov. / RMSE (final) |\n"
+     << "|---|---|---|---|---|---|---|\n";
+  for (const RunRecord* r : list)
+    md << "| " << r->id << " | " << r->mapper << " | " << slip(*r, "final", "median_deg") << " / "
+       << slip(*r, "final", "p90_deg") << " | " << slip(*r, "mean", "median_deg") << " / "
+       << slip(*r, "mean", "p90_deg") << " | " << final_and_mean(*r, "edf_circle", coverage_cell) << " | "
+       << final_and_mean(*r, "edf_circle", rmse_cell) << " | " << coverage_cell(*r, "circle", "final")
+       << " / " << rmse_cell(*r, "circle", "final") << " |\n";
+  return md.str() + "\n";
+}
+
+// A scenario's plots over frames and of time against voxel size, drawn into dir/plots.
+std::string scenario_plots(const fs::path& dir, const std::string& scenario,
+                           const std::vector<const RunRecord*>& list, const std::vector<std::string>& stages) {
+  const std::vector<std::pair<std::string, std::string>> series = {
+      {"circle_coverage", "circle coverage"}, {"cylinder_coverage", "cylinder coverage"},
+      {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
+      {"circle_rmse_off_edges", "circle RMSE off silhouette edges (m)"},
+      {"cylinder_rmse_off_edges", "cylinder RMSE off silhouette edges (m)"},
+      {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"}};
+  std::ostringstream md;
+  for (const auto& [column, label] : series) {
+    const std::string name = scenario + "_" + column + ".png";
+    plot_over_frames(dir / "plots" / name, list, column, scenario + ": " + label + " over frames", label);
+    if (fs::exists(dir / "plots" / name)) md << "![" << label << "](plots/" << name << ")\n\n";
+  }
+  const std::string tname = scenario + "_time_vs_voxel.png";
+  plot_time_vs_voxel(dir / "plots" / tname, list, stages);
+  if (fs::exists(dir / "plots" / tname)) md << "![time vs voxel](plots/" << tname << ")\n\n";
+  return md.str();
+}
+
+std::string report_intro(const fs::path& dir, std::size_t runs) {
+  return "# sonomap report: " + dir.filename().string() + "\n\n" + std::to_string(runs) +
+         " runs, rolled up from `" + (dir / "runs").string() +
+         "` (`rollup.csv` has every number below). Coverage: known bins also occupied in the ground "
+         "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
+         "the estimate but empty in the truth or more than the tolerance closer "
+         "(docs/conventions.md).\n\n";
+}
+
 }  // namespace
 
 ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& junit) {
   const std::vector<RunRecord> runs = read_runs(dir);
   if (runs.empty()) throw InputError(dir.string() + ": no finished run under " + (dir / "runs").string());
   const std::vector<std::string> stages = stage_names(runs);
+  const std::string csv = rollup_csv(runs, stages);
+  write_text_file(dir / "rollup.csv", csv);
 
-  // rollup.csv: one row per run.
-  std::ostringstream csv;
-  csv << "run,scenario,variant,mapper,voxel,seed,frames";
-  for (const auto& [name, unused] : summary_metrics(json::object())) csv << ',' << name;
-  for (const auto& s : stages) csv << ",median_" << s << "_ms";
-  csv << '\n';
-  for (const RunRecord& r : runs) {
-    csv << r.id << ',' << r.scenario << ',' << r.variant << ',' << r.mapper << ','
-        << (std::isfinite(r.voxel) ? fmt::format("{}", r.voxel) : "") << ',' << r.seed << ','
-        << r.summary["config"].value("frames", 0);
-    for (const auto& [name, cell] : summary_metrics(r.summary)) csv << ',' << cell;
-    for (const auto& s : stages) csv << ',' << median(r, s);
-    csv << '\n';
-  }
-  write_text_file(dir / "rollup.csv", csv.str());
-
-  // Plots per scenario.
   fs::create_directories(dir / "plots");
   std::map<std::string, std::vector<const RunRecord*>> by_scenario;
   for (const RunRecord& r : runs) by_scenario[r.scenario].push_back(&r);
   std::ostringstream md;
-  md << "# sonomap report: " << dir.filename().string() << "\n\n"
-     << runs.size() << " runs, rolled up from `" << (dir / "runs").string() << "` ("
-     << "`rollup.csv` has every number below). Coverage: known bins also occupied in the ground "
-        "truth / occupied truth bins; RMSE over bins known in both (m); ghosts: bins known in "
-        "the estimate but empty in the truth or more than the tolerance closer "
-        "(docs/conventions.md).\n\n";
-  const RollupTable rollup = RollupTable::parse(csv.str());
+  md << report_intro(dir, runs.size());
+  const RollupTable rollup = RollupTable::parse(csv);
   const std::vector<Claim> claims = read_claims(dir), gates = read_claims(dir, "gates.json");
   ReportOutcome outcome{static_cast<int>(runs.size()), 0};
   md << gates_section(gates, rollup, outcome.failed_gates) << claims_section(claims, rollup)
      << stats_section(dir, rollup);
   if (!junit.empty()) write_text_file(junit, junit_xml(claims, gates, rollup));
   for (const auto& [scenario, list] : by_scenario) {
-    md << "## " << scenario << "\n\n"
-       << "| run | mapper | voxel | circle cov. (final / mean) | circle RMSE (final / mean) | "
-          "circle ghosts (final) | cylinder cov. (final / mean) | cylinder RMSE (final / mean) | "
-          "cylinder ghosts (final) | integrate ms (median) |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|\n";
-    for (const RunRecord* r : list) {
-      auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
-      auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
-      md << "| " << r->id << " | " << r->mapper << " | "
-         << (std::isfinite(r->voxel) ? fmt::format("{}", r->voxel) : "-") << " | "
-         << pct("circle", "final") << " / " << pct("circle", "mean") << " | " << rmse("circle", "final")
-         << " / " << rmse("circle", "mean") << " | " << value(*r, "circle", "final", "ghosts") << " | "
-         << pct("cylinder", "final") << " / " << pct("cylinder", "mean") << " | "
-         << rmse("cylinder", "final") << " / " << rmse("cylinder", "mean") << " | "
-         << value(*r, "cylinder", "final", "ghosts") << " | " << median(*r, "integrate") << " |\n";
-    }
-    md << "\n";
-    if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return r->summary.contains("edf"); })) {
-      // The paper's "Compare to EDF": the field's direction to the closest surface against each
-      // bin's bearing, and the circle the EDF gives by sphere tracing, beside the map's circle.
-      md << "### Compare to EDF\n\n"
-         << "Bearing slip: angle between the direction to the closest surface (the EDF's "
-            "-gradient at the bin's point on the sample circle) and the bin's ray, degrees, over "
-            "the bins where the field is observed. EDF circle: ranges sphere-traced in the field "
-            "along each bin's ray at the sensor's height.\n\n"
-         << "| run | mapper | slip median / p90 (final) | slip median / p90 (mean) | "
-            "EDF circle cov. (final / mean) | EDF circle RMSE (final / mean) | "
-            "map circle cov. / RMSE (final) |\n"
-         << "|---|---|---|---|---|---|---|\n";
-      auto or_dash = [](const std::string& v) { return v.empty() ? std::string("-") : v; };
-      for (const RunRecord* r : list) {
-        auto pct = [&](const char* raster, const char* which) { return coverage_cell(*r, raster, which); };
-        auto rmse = [&](const char* raster, const char* which) { return rmse_cell(*r, raster, which); };
-        md << "| " << r->id << " | " << r->mapper << " | " << or_dash(slip(*r, "final", "median_deg"))
-           << " / " << or_dash(slip(*r, "final", "p90_deg")) << " | "
-           << or_dash(slip(*r, "mean", "median_deg")) << " / " << or_dash(slip(*r, "mean", "p90_deg"))
-           << " | " << pct("edf_circle", "final") << " / " << pct("edf_circle", "mean") << " | "
-           << rmse("edf_circle", "final") << " / " << rmse("edf_circle", "mean") << " | "
-           << pct("circle", "final") << " / " << rmse("circle", "final") << " |\n";
-      }
-      md << "\n";
-    }
-    const std::vector<std::pair<std::string, std::string>> series = {
-        {"circle_coverage", "circle coverage"}, {"cylinder_coverage", "cylinder coverage"},
-        {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
-        {"circle_rmse_off_edges", "circle RMSE off silhouette edges (m)"},
-        {"cylinder_rmse_off_edges", "cylinder RMSE off silhouette edges (m)"},
-        {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"}};
-    for (const auto& [column, label] : series) {
-      const std::string name = scenario + "_" + column + ".png";
-      plot_over_frames(dir / "plots" / name, list, column, scenario + ": " + label + " over frames", label);
-      if (fs::exists(dir / "plots" / name)) md << "![" << label << "](plots/" << name << ")\n\n";
-    }
-    const std::string tname = scenario + "_time_vs_voxel.png";
-    plot_time_vs_voxel(dir / "plots" / tname, list, stages);
-    if (fs::exists(dir / "plots" / tname)) md << "![time vs voxel](plots/" << tname << ")\n\n";
+    md << "## " << scenario << "\n\n" << runs_table(list);
+    if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return r->summary.edf.has_value(); }))
+      md << edf_table(list);
+    md << scenario_plots(dir, scenario, list, stages);
   }
   write_text_file(dir / "report.md", md.str());
   if (!quiet)

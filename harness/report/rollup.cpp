@@ -4,29 +4,31 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <sstream>
-
-using nlohmann::json;
 
 namespace sonomap::harness {
 
 namespace {
 
-std::string number_text(const json& v, const char* format) {
-  return v.is_number() ? fmt::format(fmt::runtime(format), v.get<double>()) : "";
+std::string number_text(double v, const char* format) {
+  return std::isfinite(v) ? fmt::format(fmt::runtime(format), v) : "";
 }
 
-// summary["metrics"][raster][which][name], or the EDF slip summary["edf"]["slip"][which][name].
-const json& lookup(const json& summary, std::initializer_list<const char*> path) {
-  static const json null;
-  const json* at = &summary;
-  for (const char* key : path) {
-    if (!at->is_object() || !at->contains(key)) return null;
-    at = &(*at)[key];
+// coverage, rmse, rmse_off_edges and ghosts of a raster's final frame and its means (NaN where
+// the run has no such raster or frame).
+using FourMetrics = std::array<double, 4>;
+std::pair<FourMetrics, FourMetrics> final_and_mean(const RasterSummary* r) {
+  FourMetrics final_frame{NAN, NAN, NAN, NAN}, mean{NAN, NAN, NAN, NAN};
+  if (r && r->final_frame) {
+    const eval::RasterMetrics& m = *r->final_frame;
+    final_frame = {m.coverage, m.rmse, m.rmse_off_edges, static_cast<double>(m.ghosts)};
   }
-  return *at;
+  if (r) mean = {r->mean.coverage, r->mean.rmse, r->mean.rmse_off_edges, r->mean.ghosts};
+  return {final_frame, mean};
 }
 
 }  // namespace
@@ -73,17 +75,26 @@ std::vector<std::string> RollupTable::metrics() const {
   return frames < 0 ? std::vector<std::string>{} : std::vector<std::string>(header.begin() + frames + 1, header.end());
 }
 
-std::vector<std::pair<std::string, std::string>> summary_metrics(const json& summary) {
+std::vector<std::pair<std::string, std::string>> summary_metrics(const RunSummary& summary) {
   std::vector<std::pair<std::string, std::string>> out;
-  for (const char* raster : {"circle", "cylinder", "edf_circle"})
-    for (const char* which : {"final", "mean"})
-      for (const char* name : {"coverage", "rmse", "rmse_off_edges", "ghosts"})
-        out.emplace_back(fmt::format("{}_{}_{}", raster, which, name),
-                         number_text(lookup(summary, {"metrics", raster, which, name}), "{:.6g}"));
-  for (const char* which : {"final", "mean"})
-    for (const char* name : {"median_deg", "p90_deg"})
-      out.emplace_back(fmt::format("edf_slip_{}_{}", which, name),
-                       number_text(lookup(summary, {"edf", "slip", which, name}), "{:.2f}"));
+  const std::pair<const char*, const RasterSummary*> rasters[] = {
+      {"circle", &summary.circle}, {"cylinder", &summary.cylinder},
+      {"edf_circle", summary.edf_circle ? &*summary.edf_circle : nullptr}};
+  const char* names[] = {"coverage", "rmse", "rmse_off_edges", "ghosts"};
+  for (const auto& [raster, r] : rasters) {
+    const auto [final_frame, mean] = final_and_mean(r);
+    for (const auto& [which, values] : {std::pair{"final", final_frame}, std::pair{"mean", mean}})
+      for (std::size_t i = 0; i < values.size(); ++i)
+        out.emplace_back(fmt::format("{}_{}_{}", raster, which, names[i]), number_text(values[i], "{:.6g}"));
+  }
+  const std::optional<SlipStats> slip_final = summary.edf ? summary.edf->final_slip : std::nullopt;
+  const double slip[2][2] = {{slip_final ? slip_final->median_deg : NAN, slip_final ? slip_final->p90_deg : NAN},
+                             {summary.edf ? summary.edf->mean_median_deg : NAN,
+                              summary.edf ? summary.edf->mean_p90_deg : NAN}};
+  for (int w = 0; w < 2; ++w)
+    for (int n = 0; n < 2; ++n)
+      out.emplace_back(fmt::format("edf_slip_{}_{}", w ? "mean" : "final", n ? "p90_deg" : "median_deg"),
+                       number_text(slip[w][n], "{:.2f}"));
   return out;
 }
 

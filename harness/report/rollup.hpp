@@ -4,7 +4,7 @@
 // `diff` read their numbers through it, so they all name metrics the same way.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include "harness/formats/run_summary.hpp"
 
 #include <string>
 #include <utility>
@@ -30,7 +30,7 @@ struct RollupTable {
 };
 
 // A result directory's metrics under their rollup.csv names (circle_final_coverage, ...,
-// edf_slip_mean_p90_deg), from its summary.json; "" where a metric is undefined or absent.
-std::vector<std::pair<std::string, std::string>> summary_metrics(const nlohmann::json& summary);
+// edf_slip_mean_p90_deg), from its summary; "" where a metric is undefined or absent.
+std::vector<std::pair<std::string, std::string>> summary_metrics(const RunSummary& summary);
 
 }  // namespace sonomap::harness

@@ -336,9 +336,11 @@ void StagedFile::commit() {
   sync_path(parent_of(final_), true);
 }
 
+void StagedFile::write(const std::string& text) { write_all(staging_, text); }
+
 void write_text_file(const fs::path& path, const std::string& text, const Recognise& ours) {
   StagedFile file(path, ours);
-  write_all(file.path(), text);
+  file.write(text);
   file.commit();
 }
 

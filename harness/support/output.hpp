@@ -87,6 +87,8 @@ class StagedFile {
   StagedFile(const StagedFile&) = delete;
   StagedFile& operator=(const StagedFile&) = delete;
   const std::filesystem::path& path() const { return staging_; }
+  // Writes `text` as the whole file, checked and fsynced (WriteError with the reason).
+  void write(const std::string& text);
   void commit();
 
  private:

@@ -2,12 +2,14 @@
 // A result is published whole or not at all: a failed write (full disk, file-size limit) is exit
 // status 1 with the reason, a signal is exit 128 + signal, and neither leaves anything behind;
 // staging folders of dead processes are swept by the next run.
+#include "score_support.hpp"
 #include "test_safety_support.hpp"
 
 #include "harness/support/output.hpp"
 
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <sys/mount.h>
 #include <thread>
 
@@ -113,4 +115,66 @@ TEST_CASE("a stale staging folder of a dead process is removed by the next run, 
   REQUIRE(result.status == 0);
   CHECK(!fs::exists(stale));
   CHECK(text_of(users) == "cat");
+}
+
+namespace {
+
+// Whether process `pid` runs sonomap (it has exec'd: the test's own handlers, inherited by the
+// fork, are gone) and has a handler installed for `signal` (the SigCgt mask of
+// /proc/PID/status), i.e. it will stop cleanly rather than die of it.
+bool catches(pid_t pid, int signal) {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/" + std::to_string(pid) + "/exe", ec);
+  if (ec || exe != fs::canonical(std::getenv("SONOMAP_EXE"))) return false;
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (signal - 1)) & 1u;
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("SIGINT and SIGTERM while brir synthesises exit 128 + signal and publish nothing",
+          "[safety][brir]") {
+  ScratchDir scratch("safety-brir-signals");
+  for (int signal : {SIGINT, SIGTERM}) {
+    const fs::path out = scratch.path() / ("brirs" + std::to_string(signal));
+    const fs::path log = scratch.path() / ("log" + std::to_string(signal));
+    const pid_t pid = start_sonomap({"--quiet", "brir", "--out", out.string()}, log);
+    // The handler goes in when the synthesis starts (the HRIRs are read by then).
+    for (int i = 0; i < 6000 && !catches(pid, signal); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    REQUIRE(catches(pid, signal));
+    ::kill(pid, signal);
+    const int status = wait_status(pid);
+    const std::string output = text_of(log);
+    INFO("signal " << signal << ": " << output);
+    CHECK(status == 128 + signal);
+    CHECK(output.find("interrupted") != std::string::npos);  // stopped by sonomap, not killed
+    CHECK(!fs::exists(out));
+    fs::remove(log);
+  }
+  CHECK(partial_entries(scratch.path()).empty());
+}
+
+TEST_CASE("score whose writes fail (file-size limit) exits 1 with the reason and publishes nothing",
+          "[safety][score]") {
+  ScratchDir scratch("safety-score-fsize");
+  const fs::path scene = scratch.write("square.yaml", square_room_scenario());
+  std::vector<int> frames(20);
+  for (int i = 0; i < 20; ++i) frames[i] = i;
+  // 20 frames x 360 bins of circle.csv with truth (about 170 kB): well over the 64 KiB limit.
+  const fs::path circle = scratch.write("circle.csv", constant_circle_csv(frames, 1.25));
+  const fs::path out = scratch.path() / "out", log = scratch.path() / "score.log";
+  const pid_t pid = start_sonomap({"--quiet", "score", scene.string(), "--circle", circle.string(), "--out",
+                                   out.string(), "--frames", "20", "--pictures", "-1"},
+                                  log, 64 * 1024);
+  const int status = wait_status(pid);
+  const std::string output = text_of(log);
+  INFO(output);
+  CHECK(status == 1);
+  CHECK(output.find("File too large") != std::string::npos);
+  CHECK(!fs::exists(out));
+  CHECK(partial_entries(scratch.path()).empty());
 }

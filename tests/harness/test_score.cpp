@@ -8,6 +8,8 @@
 #include "score_support.hpp"
 #include "test_scenario_files.hpp"
 
+#include "harness/formats/run_summary.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -119,4 +121,50 @@ TEST_CASE("bad estimate files are refused with file:line and leave nothing behin
     CHECK(s.output.find(words) != std::string::npos);
     CHECK(sonomap::test::nothing_written(out));
   }
+}
+
+TEST_CASE("a scored folder reads back through the run's summary type, with what was scored",
+          "[score][summary]") {
+  sonomap::test::ScratchDir scratch("score-typed");
+  const fs::path scene = scratch.write("square.yaml", sonomap::test::square_room_scenario());
+  const fs::path circle = scratch.write("circle.csv", sonomap::test::constant_circle_csv({0, 1}, 1.25));
+  const fs::path out = scratch.path() / "out";
+  REQUIRE(run_sonomap({"--quiet", "score", scene.string(), "--circle", circle.string(), "--out", out.string(),
+                       "--pictures", "-1", "--tag", "variant=const"}).status == 0);
+  const sonomap::harness::RunSummary s = sonomap::harness::read_run_summary(out);
+  REQUIRE(s.scored.has_value());
+  CHECK(s.scored->circle == circle.string());
+  CHECK_FALSE(s.scored->cylinder.has_value());
+  CHECK(s.config.command == std::optional<std::string>(""));
+  CHECK_FALSE(s.config.edf.has_value());  // score runs no EDF comparison
+  CHECK(s.config.mapper == "external");
+  CHECK(s.tags.at("variant") == "const");
+  CHECK(s.evaluated_frames == 2);
+  REQUIRE(s.circle.final_frame.has_value());
+  CHECK(s.circle.final_frame->rmse == Approx(sonomap::test::square_room_rmse(1.25)).epsilon(1e-6));
+  CHECK_FALSE(s.cylinder.final_frame.has_value());
+  // The file is the struct written back: nothing in it that the type does not hold.
+  CHECK(json(s) == summary_of(out));
+}
+
+TEST_CASE("diff and report refuse a result of another schema version, naming its summary.json",
+          "[score][summary][diff]") {
+  sonomap::test::ScratchDir scratch("score-schema");
+  const fs::path scene = scratch.write("square.yaml", sonomap::test::square_room_scenario());
+  const fs::path circle = scratch.write("circle.csv", sonomap::test::constant_circle_csv({0, 1}, 1.25));
+  const fs::path sweep = scratch.path() / "sweep", good = sweep / "runs" / "good", old = sweep / "runs" / "old";
+  fs::create_directories(sweep / "runs");
+  for (const fs::path& out : {good, old})
+    REQUIRE(run_sonomap({"--quiet", "score", scene.string(), "--circle", circle.string(), "--out", out.string(),
+                         "--pictures", "-1"}).status == 0);
+  json older = summary_of(old);
+  older["schema_version"] = 0;
+  std::ofstream(old / "summary.json") << older.dump(2);
+  const auto diff = run_sonomap({"diff", good.string(), old.string()});
+  CHECK(diff.status == 2);
+  CHECK(diff.output.find((old / "summary.json").string()) != std::string::npos);
+  CHECK(diff.output.find("schema_version 0") != std::string::npos);
+  const auto report = run_sonomap({"--quiet", "report", sweep.string()});
+  CHECK(report.status == 2);
+  CHECK(report.output.find((old / "summary.json").string()) != std::string::npos);
 }
