@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace sonomap::audio {
@@ -83,6 +84,12 @@ class BrirSynthesizer {
   BinauralIr synthesize(double azimuth_deg, double distance_m) const;
   // The whole grid (parallel over grid points; the result does not depend on thread count).
   BrirSet synthesize(const BrirGrid& grid) const;
+
+  // The whole grid made on demand: the same responses as synthesize(grid) followed by
+  // BrirSet::normalise_to_reference(), but only the points looked up stay in memory. Every
+  // point is synthesised once here for the reference level (in parallel, two at a time in
+  // memory per thread) and again on its first lookup. `self` must own this synthesiser.
+  static BrirSet synthesize_on_demand(std::shared_ptr<const BrirSynthesizer> self, const BrirGrid& grid);
 
   size_t length() const { return length_; }
   double absorption() const { return absorption_; }

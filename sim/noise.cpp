@@ -14,6 +14,22 @@ namespace {
 // Keeps the grazing terms finite when a surface is seen exactly edge-on.
 constexpr double kMaxTheta = M_PI / 2 - 1e-3;
 
+// axial_sigma and lateral_sigma_px for the per-pixel loops: a library's exported functions are
+// not inlined (they could be interposed), these are.
+inline double axial_sigma_of(double z, double theta) {
+  double sigma = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
+  if (theta > M_PI / 3) {
+    const double t = std::min(theta, kMaxTheta);
+    sigma += 0.0001 / std::sqrt(z) * t * t / ((M_PI / 2 - t) * (M_PI / 2 - t));
+  }
+  return sigma;
+}
+
+inline double lateral_sigma_px_of(double theta) {
+  const double t = std::min(theta, kMaxTheta);
+  return 0.8 + 0.035 * t / (M_PI / 2 - t);
+}
+
 // Round half up (floor(x + 0.5)) without a libm call; offsets are small, so the int
 // conversion cannot overflow after the clamp.
 int nearest_int(double x) {
@@ -50,7 +66,7 @@ struct RowRandom {
 std::size_t jitter_source(const RowRandom& rng, int u, int v, int width, int height, float incidence) {
   const std::uint64_t word = rng.jitter.bits_at(static_cast<std::uint64_t>(u));
   const std::uint64_t slow = 2 * static_cast<std::uint64_t>(u);
-  const double sigma = lateral_sigma_px(incidence);
+  const double sigma = lateral_sigma_px_of(incidence);
   const float du = rng.jitter.normal32(static_cast<std::uint32_t>(word), slow);
   const float dv = rng.jitter.normal32(static_cast<std::uint32_t>(word >> 32), slow + 1);
   const int su = std::clamp(u + nearest_int(sigma * du), 0, width - 1);
@@ -61,7 +77,7 @@ std::size_t jitter_source(const RowRandom& rng, int u, int v, int width, int hei
 // z + N(0, axial_sigma) from the low half of the pixel's axial word; <= 0 becomes no return.
 float axial_noisy(float z, float incidence, std::uint64_t word, const RowRandom& rng, int u) {
   const float n = rng.axial.normal32(static_cast<std::uint32_t>(word), static_cast<std::uint64_t>(u));
-  const double noisy = z + axial_sigma(z, incidence) * n;
+  const double noisy = z + axial_sigma_of(z, incidence) * n;
   return noisy > 0.0 ? static_cast<float>(noisy) : 0.0f;
 }
 
@@ -79,19 +95,9 @@ float quantised(float z, double fb, double step) {
 
 }  // namespace
 
-double axial_sigma(double z, double theta) {
-  double sigma = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
-  if (theta > M_PI / 3) {
-    const double t = std::min(theta, kMaxTheta);
-    sigma += 0.0001 / std::sqrt(z) * t * t / ((M_PI / 2 - t) * (M_PI / 2 - t));
-  }
-  return sigma;
-}
+double axial_sigma(double z, double theta) { return axial_sigma_of(z, theta); }
 
-double lateral_sigma_px(double theta) {
-  const double t = std::min(theta, kMaxTheta);
-  return 0.8 + 0.035 * t / (M_PI / 2 - t);
-}
+double lateral_sigma_px(double theta) { return lateral_sigma_px_of(theta); }
 
 namespace {
 

@@ -103,27 +103,20 @@ audio::BrirSynthConfig room_from_box(const Eigen::Vector3d& min_corner,
 
 audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::path& hrir_file,
                                 bool quiet) {
-  const audio::HrirSet hrirs = read_hrir_set(hrir_file, room.sample_rate);
-  const audio::BrirSynthesizer synth(hrirs, room);
+  auto synth = std::make_shared<const audio::BrirSynthesizer>(read_hrir_set(hrir_file, room.sample_rate), room);
   const audio::BrirGrid grid = audio::BrirGrid::paper();
   try {
-    for (double d : grid.distances_m) synth.check_source(0.0, d);
+    for (double d : grid.distances_m) synth->check_source(0.0, d);
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("option --ir-length: ") + e.what());
   }
-  const size_t na = grid.azimuths_deg.size();
-  std::vector<audio::BinauralIr> irs(na * grid.distances_m.size());
-  Progress progress("BRIRs", static_cast<long>(irs.size()), quiet);
-  std::atomic<long> done{0};
-  // Each grid point in its own slot: the set does not depend on the thread count.
-  tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
-    irs[i] = synth.synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
-    ++done;
-  });
-  progress.update(done);
+  const long points = static_cast<long>(grid.azimuths_deg.size() * grid.distances_m.size());
+  Progress progress("BRIRs", points, quiet);
+  // Made on demand: a sweep plays a few dozen of the grid's points, and only those stay in
+  // memory (the same responses and level as synthesising and normalising the whole grid).
+  audio::BrirSet set = audio::BrirSynthesizer::synthesize_on_demand(synth, grid);
+  progress.update(points);
   progress.finish();
-  audio::BrirSet set(room.sample_rate, grid, std::move(irs));
-  set.normalise_to_reference();
   return set;
 }
 
