@@ -102,7 +102,7 @@ audio::BrirSynthConfig room_from_box(const Eigen::Vector3d& min_corner,
 }
 
 audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::path& hrir_file,
-                                bool quiet) {
+                                bool quiet, bool on_demand) {
   auto synth = std::make_shared<const audio::BrirSynthesizer>(read_hrir_set(hrir_file, room.sample_rate), room);
   const audio::BrirGrid grid = audio::BrirGrid::paper();
   try {
@@ -112,9 +112,10 @@ audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::pa
   }
   const long points = static_cast<long>(grid.azimuths_deg.size() * grid.distances_m.size());
   Progress progress("BRIRs", points, quiet);
-  // Made on demand: a sweep plays a few dozen of the grid's points, and only those stay in
-  // memory (the same responses and level as synthesising and normalising the whole grid).
-  audio::BrirSet set = audio::BrirSynthesizer::synthesize_on_demand(synth, grid);
+  // On demand, a sweep's few dozen points stay in memory (the same responses and level as the
+  // whole grid synthesised and normalised, which a writer of every point wants instead).
+  audio::BrirSet set = on_demand ? audio::BrirSynthesizer::synthesize_on_demand(synth, grid) : synth->synthesize(grid);
+  if (!on_demand) set.normalise_to_reference();
   progress.update(points);
   progress.finish();
   return set;
@@ -200,7 +201,7 @@ std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quie
                  size.x(), size.y(), size.z(), room.rt60, room.max_order,
                  s.room.hrir_file.string().c_str());
   }
-  return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet));
+  return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet, true));
 }
 
 namespace {
