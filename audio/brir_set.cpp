@@ -83,6 +83,23 @@ BrirSet::BrirSet(double sample_rate, BrirGrid grid, std::vector<BinauralIr> irs)
   }
 }
 
+BrirSet::BrirSet(double sample_rate, BrirGrid grid, size_t ir_length, MakeIr make)
+    : sample_rate_(sample_rate), grid_(std::move(grid)), ir_length_(ir_length), make_(std::move(make)) {
+  if (!(sample_rate_ > 0.0) || !std::isfinite(sample_rate_))
+    throw std::invalid_argument("BRIR set: sample rate must be positive");
+  if (grid_.azimuths_deg.empty() || grid_.distances_m.empty())
+    throw std::invalid_argument("BRIR set: the grid needs at least one azimuth and one distance");
+  if (ir_length_ == 0 || !make_) throw std::invalid_argument("BRIR set: no response length or maker");
+  irs_.resize(grid_.azimuths_deg.size() * grid_.distances_m.size());
+  made_ = std::make_unique<std::once_flag[]>(irs_.size());
+}
+
+size_t BrirSet::made_count() const {
+  size_t n = 0;
+  for (const BinauralIr& ir : irs_) n += !ir.left.empty();
+  return n;
+}
+
 size_t nearest_distance_index(const std::vector<double>& values, double metres) {
   if (values.empty()) throw std::invalid_argument("nearest distance: empty grid");
   constexpr double kTie = 1e-6;
@@ -116,22 +133,42 @@ size_t BrirSet::nearest_distance(double metres) const {
 const BinauralIr& BrirSet::at(size_t distance_index, size_t azimuth_index) const {
   if (distance_index >= distance_count() || azimuth_index >= azimuth_count())
     throw std::invalid_argument("BRIR set: index out of range");
-  return irs_[distance_index * azimuth_count() + azimuth_index];
+  const size_t i = distance_index * azimuth_count() + azimuth_index;
+  if (made_) {
+    std::call_once(made_[i], [&] {
+      BinauralIr ir = make_(distance_index, azimuth_index);
+      if (ir.left.size() != ir_length_ || ir.right.size() != ir_length_ || !all_finite(ir.left) ||
+          !all_finite(ir.right))
+        throw std::logic_error("BRIR set: a response made on demand has the wrong length or is not finite");
+      // Each slot is written once, under its own flag, before any reader of that slot returns.
+      irs_[i] = std::move(ir);
+    });
+  }
+  return irs_[i];
+}
+
+double loudest_ear_energy(const BinauralIr& ir) {
+  double loudest = 0.0;
+  for (const auto* ear : {&ir.left, &ir.right}) {
+    double energy = 0.0;
+    for (float x : *ear) energy += double(x) * x;
+    loudest = std::max(loudest, energy);
+  }
+  return loudest;
+}
+
+void scale(BinauralIr& ir, double factor) {
+  for (auto* ear : {&ir.left, &ir.right})
+    for (float& x : *ear) x = static_cast<float>(x * factor);
 }
 
 double BrirSet::normalise_to_reference() {
+  if (made_) throw std::logic_error("BRIR set: a set made on demand is normalised by its maker");
   double loudest = 0.0;
-  for (const BinauralIr& ir : irs_)
-    for (const auto* ear : {&ir.left, &ir.right}) {
-      double energy = 0.0;
-      for (float x : *ear) energy += double(x) * x;
-      loudest = std::max(loudest, energy);
-    }
+  for (const BinauralIr& ir : irs_) loudest = std::max(loudest, loudest_ear_energy(ir));
   if (!(loudest > 0.0)) return 1.0;
   const double factor = 1.0 / std::sqrt(loudest);
-  for (BinauralIr& ir : irs_)
-    for (auto* ear : {&ir.left, &ir.right})
-      for (float& x : *ear) x = static_cast<float>(x * factor);
+  for (BinauralIr& ir : irs_) scale(ir, factor);
   return factor;
 }
 

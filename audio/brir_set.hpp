@@ -6,6 +6,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace sonomap::audio {
@@ -43,6 +46,11 @@ class BrirSet {
  public:
   BrirSet() = default;
   BrirSet(double sample_rate, BrirGrid grid, std::vector<BinauralIr> irs);
+  // A set whose responses are made on first lookup by make(distance index, azimuth index), each
+  // of ir_length samples per ear, and kept: memory for the points that are played only.
+  // Lookups may come from several threads (each point is made once).
+  using MakeIr = std::function<BinauralIr(size_t distance_index, size_t azimuth_index)>;
+  BrirSet(double sample_rate, BrirGrid grid, size_t ir_length, MakeIr make);
 
   double sample_rate() const { return sample_rate_; }
   const BrirGrid& grid() const { return grid_; }
@@ -50,6 +58,7 @@ class BrirSet {
   size_t distance_count() const { return grid_.distances_m.size(); }
   size_t ir_length() const { return ir_length_; }
   bool empty() const { return irs_.empty(); }
+  size_t made_count() const;  // responses held in memory (all of them unless made on demand)
 
   size_t nearest_azimuth(double azimuth_deg) const;  // circular distance, any angle
   size_t nearest_distance(double metres) const;
@@ -58,15 +67,24 @@ class BrirSet {
   // Scales the set to the reference level every set is played at: its loudest response (one
   // ear at one grid point, energy = sum of squared samples) gets unit energy, so sets from
   // different rooms, HRIRs or files start from the same level. Returns the factor applied
-  // (1 for an all-zero set).
+  // (1 for an all-zero set). A set made on demand must be normalised by its maker instead
+  // (throws std::logic_error).
   double normalise_to_reference();
 
  private:
   double sample_rate_ = 0.0;
   BrirGrid grid_;
-  std::vector<BinauralIr> irs_;
+  mutable std::vector<BinauralIr> irs_;  // mutable: a set made on demand fills it in at()
   size_t ir_length_ = 0;
+  // Made on demand: the maker, and one flag per grid point (its response is in irs_ once set).
+  MakeIr make_;
+  std::unique_ptr<std::once_flag[]> made_;
 };
+
+// The reference level's pieces (normalise_to_reference): the larger of the two ears' energies
+// (sum of squared samples), and every sample times `factor`.
+double loudest_ear_energy(const BinauralIr& ir);
+void scale(BinauralIr& ir, double factor);
 
 // Angle difference a - b wrapped to (-180, 180].
 double wrap_degrees_180(double degrees);

@@ -404,14 +404,36 @@ BinauralIr BrirSynthesizer::synthesize(double azimuth_deg, double distance_m) co
   return out;
 }
 
-BrirSet BrirSynthesizer::synthesize(const BrirGrid& grid) const {
+BrirSet BrirSynthesizer::synthesize(const BrirGrid& grid, const StopRequested& stop) const {
   for (double d : grid.distances_m) check_source(0.0, d);  // before any work
   const size_t na = grid.azimuths_deg.size(), nd = grid.distances_m.size();
   std::vector<BinauralIr> irs(na * nd);
   tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
+    if (stop && stop()) return;
     irs[i] = synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
   });
   return BrirSet(config_.sample_rate, grid, std::move(irs));
+}
+
+BrirSet BrirSynthesizer::synthesize_on_demand(std::shared_ptr<const BrirSynthesizer> self, const BrirGrid& grid,
+                                              const StopRequested& stop) {
+  for (double d : grid.distances_m) self->check_source(0.0, d);  // before any work
+  const size_t na = grid.azimuths_deg.size(), nd = grid.distances_m.size();
+  // The reference level: each point's loudest ear, kept in its own slot (the maximum does not
+  // depend on the thread count), the response itself dropped.
+  std::vector<double> loudest(na * nd);
+  tbb::parallel_for(size_t{0}, loudest.size(), [&](size_t i) {
+    if (stop && stop()) return;
+    loudest[i] = loudest_ear_energy(self->synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]));
+  });
+  const double max_energy = *std::max_element(loudest.begin(), loudest.end());
+  const double factor = max_energy > 0.0 ? 1.0 / std::sqrt(max_energy) : 1.0;
+  auto make = [self, grid, factor](size_t d, size_t a) {
+    BinauralIr ir = self->synthesize(grid.azimuths_deg[a], grid.distances_m[d]);
+    if (factor != 1.0) scale(ir, factor);
+    return ir;
+  };
+  return BrirSet(self->config_.sample_rate, grid, self->length(), make);
 }
 
 }  // namespace sonomap::audio

@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 namespace sonomap::audio {
@@ -81,8 +83,19 @@ class BrirSynthesizer {
   // The BRIR pair of a source at `azimuth_deg` (head frame, counter-clockwise from ahead) and
   // horizontal `distance_m` from the head, at ear height.
   BinauralIr synthesize(double azimuth_deg, double distance_m) const;
+  // A caller's "give up now" test, polled before each grid point (e.g. a pending signal); once
+  // it returns true the remaining points are skipped and the set must be discarded.
+  using StopRequested = std::function<bool()>;
+
   // The whole grid (parallel over grid points; the result does not depend on thread count).
-  BrirSet synthesize(const BrirGrid& grid) const;
+  BrirSet synthesize(const BrirGrid& grid, const StopRequested& stop = {}) const;
+
+  // The whole grid made on demand: the same responses as synthesize(grid) followed by
+  // BrirSet::normalise_to_reference(), but only the points looked up stay in memory. Every
+  // point is synthesised once here for the reference level (in parallel, two at a time in
+  // memory per thread) and again on its first lookup. `self` must own this synthesiser.
+  static BrirSet synthesize_on_demand(std::shared_ptr<const BrirSynthesizer> self, const BrirGrid& grid,
+                                      const StopRequested& stop = {});
 
   size_t length() const { return length_; }
   double absorption() const { return absorption_; }

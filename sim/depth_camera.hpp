@@ -26,7 +26,13 @@ class DepthCamera {
 
   // The exact z-depth of the first surface along each pixel's ray, before range limits
   // (0 where nothing is hit), and the incidence angle there.
-  DepthImage trace(const World& world, const Eigen::Isometry3d& world_T_camera) const;
+  // `image` is overwritten, its buffers reused (no allocation from the second frame on).
+  void trace(const World& world, const Eigen::Isometry3d& world_T_camera, DepthImage& image) const;
+  DepthImage trace(const World& world, const Eigen::Isometry3d& world_T_camera) const {
+    DepthImage image;
+    trace(world, world_T_camera, image);
+    return image;
+  }
 
   // Pixels whose z-depth lies outside [min_range, max_range] become 0 ("no return").
   DepthImage clip_to_range(DepthImage image) const;

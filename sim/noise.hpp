@@ -46,6 +46,10 @@ DepthImage drop_out(const DepthImage& in, double p, const NoiseKey& key);
 
 // The whole model on an exact image (from DepthCamera::trace, before range limits).
 // Model::None returns the input unchanged. Range limits are applied by the caller.
+// All stages run fused in one pass per row, the same image as running them one by one.
+// `out` is overwritten, its buffers reused.
+void apply_noise(const DepthImage& truth, const NoiseSpec& spec, double focal_px, const NoiseKey& key,
+                 DepthImage& out);
 DepthImage apply_noise(const DepthImage& truth, const NoiseSpec& spec, double focal_px, const NoiseKey& key);
 
 }  // namespace sonomap::sim

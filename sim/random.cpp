@@ -31,7 +31,7 @@ double density(double x) { return std::exp(-0.5 * x * x); }
 }  // namespace
 
 RandomStream::RandomStream(std::initializer_list<std::uint64_t> key)
-    : table_(&ziggurat()), state_(mix_key(key)) {}
+    : table_(&ziggurat()), start_(mix_key(key)), state_(start_) {}
 
 const RandomStream::Ziggurat& RandomStream::ziggurat() {
   // Built once (thread-safe static initialisation) from exp, log and sqrt only.
@@ -42,7 +42,13 @@ const RandomStream::Ziggurat& RandomStream::ziggurat() {
     for (int i = 2; i < 128; ++i)
       z.x[i] = std::sqrt(-2.0 * std::log(kLayerArea / z.x[i - 1] + density(z.x[i - 1])));
     z.x[128] = 0.0;
-    for (int i = 0; i < 128; ++i) z.ratio2[i] = (z.x[i + 1] / z.x[i]) * (z.x[i + 1] / z.x[i]);
+    for (int i = 0; i <= 128; ++i) z.f[i] = density(z.x[i]);
+    for (int i = 0; i < 128; ++i) {
+      z.ratio2[i] = (z.x[i + 1] / z.x[i]) * (z.x[i + 1] / z.x[i]);
+      // |s| < inner32 iff |s| / 2^24 < x[i+1] / x[i]: the smallest integer not below the edge.
+      z.inner32[i] = static_cast<std::uint32_t>(std::ceil(0x1.0p24 * (z.x[i + 1] / z.x[i])));
+      z.width32[i] = static_cast<float>(z.x[i] * 0x1.0p-24);
+    }
     return z;
   }();
   return table;
@@ -61,16 +67,23 @@ double RandomStream::normal_slow(unsigned layer, double u) {
       } while (-2.0 * y < x * x);
       return u < 0.0 ? x - kTailStart : kTailStart - x;
     }
+    // The wedge: accept x if a point uniform in height between the layer's edges lies under
+    // the density (one exp; the edges' densities are tabulated).
     const double x = u * z.x[layer];
-    const double f0 = std::exp(-0.5 * (z.x[layer] * z.x[layer] - x * x));
-    const double f1 = std::exp(-0.5 * (z.x[layer + 1] * z.x[layer + 1] - x * x));
-    if (f1 + uniform() * (f0 - f1) < 1.0) return x;
+    if (z.f[layer + 1] + uniform() * (z.f[layer] - z.f[layer + 1]) < density(x)) return x;
     // Rejected: a fresh draw, the same as normal() (which may take the fast path).
     const std::uint64_t r = bits();
     layer = static_cast<unsigned>(r & 127u);
     u = static_cast<double>(r >> 11) * 0x1.0p-52 - 1.0;
     if (u * u < z.ratio2[layer]) return u * z.x[layer];
   }
+}
+
+float RandomStream::normal32_slow(unsigned layer, std::int32_t s, std::uint64_t slow_index) const {
+  // A stream of its own per (stream, index), started with two mixes instead of a full key.
+  const std::uint64_t salt = static_cast<std::uint64_t>(StreamPurpose::SlowNormal) * kGamma;
+  RandomStream more(mix(start_ ^ mix(slow_index + salt)), table_);
+  return static_cast<float>(more.normal_slow(layer, static_cast<double>(s) * 0x1.0p-24));
 }
 
 }  // namespace sonomap::sim

@@ -103,6 +103,8 @@ Simulation::Simulation(const Scenario& scenario) : scenario_(scenario) {
   camera_ = std::make_unique<DepthCamera>(scenario_.camera);
   localisation_ = std::make_unique<LocalisationModel>(scenario_.localisation, scenario_.seed, kSensorId,
                                                       1.0 / scenario_.camera.rate_hz);
+  truth_ = std::make_unique<DepthImage>();
+  measured_ = std::make_unique<DepthImage>();
 }
 
 Simulation::~Simulation() = default;
@@ -133,11 +135,11 @@ Frame Simulation::render(int frame) {
   out.world_T_camera = out.world_T_body * scenario_.camera.body_T_camera;
 
   world_->set_time(t);
-  const DepthImage truth = camera_->trace(*world_, true_camera_pose(t));
+  camera_->trace(*world_, true_camera_pose(t), *truth_);
   const NoiseKey key{scenario_.seed, kSensorId, static_cast<std::uint64_t>(frame)};
-  const double focal = scenario_.camera.fx;
-  DepthImage measured = camera_->clip_to_range(apply_noise(truth, scenario_.noise, focal, key));
-  out.depth = std::move(measured.z);
+  apply_noise(*truth_, scenario_.noise, scenario_.camera.fx, key, *measured_);
+  *measured_ = camera_->clip_to_range(std::move(*measured_));
+  out.depth = measured_->z;  // a copy: the buffer stays for the next frame
   out.points_camera = camera_->back_project(out.depth);
   return out;
 }

@@ -14,6 +14,7 @@ namespace sonomap::sim {
 class World;
 class DepthCamera;
 class LocalisationModel;
+struct DepthImage;
 
 class Simulation {
  public:
@@ -41,6 +42,8 @@ class Simulation {
   std::unique_ptr<World> world_;
   std::unique_ptr<DepthCamera> camera_;
   std::unique_ptr<LocalisationModel> localisation_;
+  // The exact and the measured image, kept so that frames reuse their buffers.
+  std::unique_ptr<DepthImage> truth_, measured_;
 };
 
 // Throws std::invalid_argument for zero / negative / non-finite intrinsics or resolution,

@@ -9,6 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -18,7 +20,9 @@ namespace sonomap::sim {
 
 namespace {
 
-constexpr int kTile = 4;  // 4x4 pixel tiles = one rtcIntersect16 packet
+// 4x2 pixel tiles = one rtcIntersect8 packet, AVX2's native width (rtcIntersect16 is emulated
+// there and was slower).
+constexpr int kTileW = 4, kTileH = 2, kPacket = kTileW * kTileH;
 
 void throw_on_device_error(RTCDevice device, const char* what) {
   const RTCError error = rtcGetDeviceError(device);
@@ -158,22 +162,31 @@ void World::set_time(double t) {
   rtcCommitScene(w.top);
 }
 
-RayHits World::cast(const PinholeRays& rays) const {
+namespace {
+
+// One packet of kTileW x kTileH rays: pixel i of the packet is (u0 + i % kTileW, v0 + i / kTileW).
+struct Packet {
+  alignas(32) RTCRayHit8 rayhit;
+  alignas(32) int valid[kPacket];  // rtcIntersect8 needs both 32-byte aligned
+};
+
+}  // namespace
+
+void World::cast(const PinholeRays& rays, RayHits& hits) const {
   const Impl& w = *impl_;
-  RayHits hits;
   hits.width = rays.width;
   hits.height = rays.height;
   const std::size_t n = static_cast<std::size_t>(rays.width) * rays.height;
-  hits.z.assign(n, std::numeric_limits<float>::infinity());
-  hits.normal_world.assign(n, Eigen::Vector3f::Zero());
+  hits.z.resize(n);  // every pixel is written below
+  hits.incidence.resize(n);
 
   const Eigen::Matrix3f world_R_camera = rays.world_T_camera.linear().cast<float>();
   const Eigen::Vector3f origin = rays.world_T_camera.translation().cast<float>();
-  const int tiles_x = (rays.width + kTile - 1) / kTile;
-  const int tiles_y = (rays.height + kTile - 1) / kTile;
+  const int tiles_x = (rays.width + kTileW - 1) / kTileW;
+  const int tiles_y = (rays.height + kTileH - 1) / kTileH;
   // Optical-frame direction components per column and per row (padded to whole tiles).
-  std::vector<float> x_of_column(static_cast<std::size_t>(tiles_x) * kTile);
-  std::vector<float> y_of_row(static_cast<std::size_t>(tiles_y) * kTile);
+  std::vector<float> x_of_column(static_cast<std::size_t>(tiles_x) * kTileW);
+  std::vector<float> y_of_row(static_cast<std::size_t>(tiles_y) * kTileH);
   for (std::size_t u = 0; u < x_of_column.size(); ++u)
     x_of_column[u] = static_cast<float>((static_cast<double>(u) - rays.cx) / rays.fx);
   for (std::size_t v = 0; v < y_of_row.size(); ++v)
@@ -183,44 +196,53 @@ RayHits World::cast(const PinholeRays& rays) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    RTCRayHit16 packet;
-    alignas(64) int valid[16];  // rtcIntersect16 needs both pointers 64-byte aligned
+    Packet packet;
+    RTCRay8& ray = packet.rayhit.ray;
+    RTCHit8& hit = packet.rayhit.hit;
     for (int ty = range.begin(); ty < range.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
-        for (int i = 0; i < 16; ++i) {
-          const int u = tx * kTile + i % kTile;
-          const int v = ty * kTile + i / kTile;
-          valid[i] = (u < rays.width && v < rays.height) ? -1 : 0;
-          const Eigen::Vector3f d = world_R_camera * Eigen::Vector3f(x_of_column[u], y_of_row[v], 1.0f);
-          packet.ray.org_x[i] = origin.x();
-          packet.ray.org_y[i] = origin.y();
-          packet.ray.org_z[i] = origin.z();
-          packet.ray.dir_x[i] = d.x();
-          packet.ray.dir_y[i] = d.y();
-          packet.ray.dir_z[i] = d.z();
-          packet.ray.tnear[i] = 0.0f;
-          packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
-          packet.ray.time[i] = 0.0f;
-          packet.ray.mask[i] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on: 0 would hit nothing
-          packet.ray.id[i] = static_cast<unsigned>(i);
-          packet.ray.flags[i] = 0;
-          packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-          packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        Eigen::Vector3f direction[kPacket];
+        for (int i = 0; i < kPacket; ++i) {
+          const int u = tx * kTileW + i % kTileW;
+          const int v = ty * kTileH + i / kTileW;
+          packet.valid[i] = (u < rays.width && v < rays.height) ? -1 : 0;
+          direction[i] = world_R_camera * Eigen::Vector3f(x_of_column[u], y_of_row[v], 1.0f);
+          ray.org_x[i] = origin.x();
+          ray.org_y[i] = origin.y();
+          ray.org_z[i] = origin.z();
+          ray.dir_x[i] = direction[i].x();
+          ray.dir_y[i] = direction[i].y();
+          ray.dir_z[i] = direction[i].z();
+          ray.tnear[i] = 0.0f;
+          ray.tfar[i] = std::numeric_limits<float>::infinity();
+          ray.time[i] = 0.0f;
+          ray.mask[i] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on: 0 would hit nothing
+          ray.id[i] = static_cast<unsigned>(i);
+          ray.flags[i] = 0;
+          hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+          hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid, w.top, &context, &packet);
-        for (int i = 0; i < 16; ++i) {
-          if (!valid[i] || packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-          const int u = tx * kTile + i % kTile;
-          const int v = ty * kTile + i / kTile;
-          const std::size_t p = static_cast<std::size_t>(v) * rays.width + u;
-          hits.z[p] = packet.ray.tfar[i];
-          const Eigen::Vector3f ng(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
-          hits.normal_world[p] = (w.instance_rotation[packet.hit.instID[0][i]] * ng).normalized();
+        rtcIntersect8(packet.valid, w.top, &context, &packet.rayhit);
+        float cosine[kPacket];  // of the incidence angle; 1 (angle 0) where nothing was hit
+        for (int i = 0; i < kPacket; ++i) {
+          cosine[i] = 1.0f;
+          if (!packet.valid[i] || hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+          const Eigen::Vector3f ng(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
+          // cos = d.n / (|d| |n|) in double: one root and one division instead of two normalisations.
+          const Eigen::Vector3d n = (w.instance_rotation[hit.instID[0][i]] * ng).cast<double>();
+          const Eigen::Vector3d d = direction[i].cast<double>();
+          cosine[i] = static_cast<float>(d.dot(n) / std::sqrt(d.squaredNorm() * n.squaredNorm()));
+        }
+        for (int i = 0; i < kPacket; ++i) {
+          if (!packet.valid[i]) continue;
+          const std::size_t p = static_cast<std::size_t>(ty * kTileH + i / kTileW) * rays.width + tx * kTileW + i % kTileW;
+          const bool hit_something = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+          hits.z[p] = hit_something ? ray.tfar[i] : std::numeric_limits<float>::infinity();
+          hits.incidence[p] = incidence_angle(cosine[i]);
         }
       }
     }
   });
-  return hits;
 }
 
 }  // namespace sonomap::sim

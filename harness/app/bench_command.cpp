@@ -121,15 +121,17 @@ Timing time_frames(const sim::Scenario& scenario, const std::vector<int>& frames
 
   simulation.render(frames.front());  // warm-up: first-touch allocations and TBB workers
   std::vector<double> rays_ms, rays_cpu_ms, noise_ms, noise_cpu_ms, render_ms, render_cpu_ms;
+  sim::RayHits hits;  // buffers reused across frames, as Simulation::render does
+  sim::DepthImage truth, noisy;
   for (int frame : frames) {
     const double t = simulation.time_of(frame);
     world.set_time(t);
     rays.world_T_camera = simulation.true_camera_pose(t);
-    const auto [cast_wall, cast_cpu] = milliseconds([&] { world.cast(rays); });
-    const sim::DepthImage truth = camera.trace(world, rays.world_T_camera);
+    const auto [cast_wall, cast_cpu] = milliseconds([&] { world.cast(rays, hits); });
+    camera.trace(world, rays.world_T_camera, truth);
     const sim::NoiseKey key{scenario.seed, 0, static_cast<std::uint64_t>(frame)};
     const auto [noise_wall, noise_cpu] =
-        milliseconds([&] { sim::apply_noise(truth, scenario.noise, scenario.camera.fx, key); });
+        milliseconds([&] { sim::apply_noise(truth, scenario.noise, scenario.camera.fx, key, noisy); });
     const auto [render_wall, render_cpu] = milliseconds([&] { simulation.render(frame); });
     rays_ms.push_back(cast_wall);
     rays_cpu_ms.push_back(cast_cpu);

@@ -32,7 +32,7 @@ void add_brir_command(CLI::App& app, const GlobalOptions& global) {
   cmd->callback([state, &global] {
     check_output_directory(state->out, {state->room.hrir_file});  // before the work
     const audio::BrirSynthConfig room = room_config(state->room, 48000.0);
-    const audio::BrirSet set = synthesize_brirs(room, state->room.hrir_file, global.quiet);
+    const audio::BrirSet set = synthesize_brirs(room, state->room.hrir_file, global.quiet, false);
     const Eigen::Vector3d lo = room.room.min_corner, hi = room.room.max_corner;
     const Eigen::Vector3d l = audio::listener_position(room);
     char comment[640];

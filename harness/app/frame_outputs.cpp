@@ -42,7 +42,7 @@ void SweepMaker::make_renderer(const FrameView& frame) {
         room_from_box(box.min_corner, box.max_corner, o.position, setup.room.rt60);
     room.listener_heading_deg = o.heading * 180.0 / M_PI;
     room.max_order = setup.room.order;
-    brirs = std::make_shared<const audio::BrirSet>(synthesize_brirs(room, setup.room.hrir_file, true));
+    brirs = std::make_shared<const audio::BrirSet>(synthesize_brirs(room, setup.room.hrir_file, true, true));
     const Eigen::Vector3d &lo = box.min_corner, &hi = box.max_corner;
     const nlohmann::json room_json{
         {"min_corner", {lo.x(), lo.y(), lo.z()}}, {"max_corner", {hi.x(), hi.y(), hi.z()}},

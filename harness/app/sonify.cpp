@@ -9,11 +9,9 @@
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
 
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
-#include <tbb/parallel_for.h>
 
 namespace fs = std::filesystem;
 
@@ -100,32 +98,26 @@ audio::BrirSynthConfig room_from_box(const Eigen::Vector3d& min_corner,
 }
 
 audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room, const fs::path& hrir_file,
-                                bool quiet) {
-  const audio::HrirSet hrirs = read_hrir_set(hrir_file, room.sample_rate);
-  const audio::BrirSynthesizer synth(hrirs, room);
+                                bool quiet, bool on_demand) {
+  auto synth = std::make_shared<const audio::BrirSynthesizer>(read_hrir_set(hrir_file, room.sample_rate), room);
   const audio::BrirGrid grid = audio::BrirGrid::paper();
   try {
-    for (double d : grid.distances_m) synth.check_source(0.0, d);
+    for (double d : grid.distances_m) synth->check_source(0.0, d);
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("option --ir-length: ") + e.what());
   }
-  const size_t na = grid.azimuths_deg.size();
-  std::vector<audio::BinauralIr> irs(na * grid.distances_m.size());
-  Progress progress("BRIRs", static_cast<long>(irs.size()), quiet);
-  std::atomic<long> done{0};
+  const long points = static_cast<long>(grid.azimuths_deg.size() * grid.distances_m.size());
+  Progress progress("BRIRs", points, quiet);
+  // On demand, a sweep's few dozen points stay in memory (the same responses and level as the
+  // whole grid synthesised and normalised, which a writer of every point wants instead).
   // A signal stops the synthesis within one grid point's work (the rest are skipped).
   install_interrupt_handler();
-  // Each grid point in its own slot: the set does not depend on the thread count.
-  tbb::parallel_for(size_t{0}, irs.size(), [&](size_t i) {
-    if (interrupt_requested()) return;
-    irs[i] = synth.synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
-    ++done;
-  });
+  audio::BrirSet set = on_demand ? audio::BrirSynthesizer::synthesize_on_demand(synth, grid, interrupt_requested)
+                                 : synth->synthesize(grid, interrupt_requested);
   throw_if_interrupted();
-  progress.update(done);
+  if (!on_demand) set.normalise_to_reference();
+  progress.update(points);
   progress.finish();
-  audio::BrirSet set(room.sample_rate, grid, std::move(irs));
-  set.normalise_to_reference();
   return set;
 }
 
@@ -198,7 +190,7 @@ std::shared_ptr<const audio::BrirSet> load_brirs(const SonifySetup& s, bool quie
                  size.x(), size.y(), size.z(), room.rt60, room.max_order,
                  s.room.hrir_file.string().c_str());
   }
-  return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet));
+  return std::make_shared<const audio::BrirSet>(synthesize_brirs(room, s.room.hrir_file, quiet, true));
 }
 
 namespace {

@@ -43,9 +43,11 @@ audio::BrirSynthConfig room_from_box(const Eigen::Vector3d& min_corner,
                                      const Eigen::Vector3d& max_corner,
                                      const Eigen::Vector3d& listener, double rt60);
 
-// Synthesises the paper's grid for a room (progress on stderr unless quiet).
+// Synthesises the paper's grid for a room (progress on stderr unless quiet), normalised to the
+// reference level. on_demand: each point is kept only once it is looked up (sweeps play a few
+// dozen of the 1200); otherwise every point is held (to write them all).
 audio::BrirSet synthesize_brirs(const audio::BrirSynthConfig& room,
-                                const std::filesystem::path& hrir_file, bool quiet);
+                                const std::filesystem::path& hrir_file, bool quiet, bool on_demand);
 
 struct SonifySetup {
   std::filesystem::path brir_dir;  // empty: synthesise the room below in memory

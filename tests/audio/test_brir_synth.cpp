@@ -7,7 +7,9 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <memory>
 #include <numeric>
+#include <stdexcept>
 
 using namespace sonomap::audio;
 
@@ -207,4 +209,29 @@ TEST_CASE("an IR too short for the direct sound is refused, not rendered silent"
   config.room.max_corner = {1.0, 1.0, 1.0};
   const BrirSynthesizer short_room(omni_hrirs(), config);
   CHECK_NOTHROW(short_room.synthesize(0.0, 4.0));
+}
+
+TEST_CASE("a grid made on demand holds only what was looked up, with the whole grid's level",
+          "[room][memory]") {
+  BrirSynthConfig config;
+  config.rt60 = 0.2;
+  config.max_order = 1;
+  config.length_s = 0.05;
+  BrirGrid grid;
+  grid.azimuths_deg = {-90.0, 0.0, 90.0};
+  grid.distances_m = {0.4, 1.0, 2.0};
+  auto synth = std::make_shared<const BrirSynthesizer>(omni_hrirs(), config);
+  // Truth: every point synthesised and the set scaled to its loudest ear (normalise_to_reference).
+  BrirSet whole = synth->synthesize(grid);
+  const double factor = whole.normalise_to_reference();
+  REQUIRE(factor != 1.0);
+  const BrirSet lazy = BrirSynthesizer::synthesize_on_demand(synth, grid);
+  CHECK(lazy.made_count() == 0);
+  CHECK(lazy.ir_length() == whole.ir_length());
+  CHECK(lazy.at(2, 1).left == whole.at(2, 1).left);
+  CHECK(lazy.at(0, 2).right == whole.at(0, 2).right);
+  CHECK(lazy.at(2, 1).left == whole.at(2, 1).left);  // a second lookup: the same response
+  CHECK(lazy.made_count() == 2);
+  BrirSet again = BrirSynthesizer::synthesize_on_demand(synth, grid);
+  CHECK_THROWS_AS(again.normalise_to_reference(), std::logic_error);  // already at the reference
 }
