@@ -5,8 +5,12 @@
 
 namespace sonomap {
 
-FusedGrid::FusedGrid(double voxel, float min_weight)
-    : voxel_(voxel), min_weight_(min_weight), cache_(kLeafDim * voxel) {
+FusedGrid::FusedGrid(double voxel, float min_weight, double weight_cap)
+    : voxel_(voxel),
+      min_weight_(min_weight),
+      capped_(weight_cap > 0.0),
+      weight_cap_(static_cast<float>(weight_cap)),
+      cache_(kLeafDim * voxel) {
   openvdb::initialize();
   grid_ = DistanceWeightGrid::create(openvdb::Vec2s(kUnobservedDistance, 0.0f));
 }

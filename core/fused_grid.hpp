@@ -7,6 +7,7 @@
 #include "core/marching_cubes.hpp"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 namespace sonomap {
@@ -15,10 +16,21 @@ class FusedGrid {
  public:
   static constexpr float kUnobservedDistance = -100.0f;  // background: never observed
 
-  FusedGrid(double voxel, float min_weight);
+  // weight_cap: fused weight ceiling (0 = none).
+  FusedGrid(double voxel, float min_weight, double weight_cap);
   double voxel() const { return voxel_; }
   DistanceWeightGrid& grid() { return *grid_; }
   const DistanceWeightGrid& grid() const { return *grid_; }
+
+  // The one fusion rule of both maps, a weighted running average: a voxel holding (d, w) that
+  // receives updates summing to (sum of w_i d_i, sum of w_i) becomes
+  // ((d w + sum w_i d_i) / (w + sum w_i), min(w + sum w_i, cap)). Pass old weight 0 to
+  // forget the old value.
+  openvdb::Vec2s weighted_average(const openvdb::Vec2s& old, const openvdb::Vec2s& sum) const {
+    const float w_new = old[1] + sum[1];
+    const float d_new = (old[0] * old[1] + sum[0]) / w_new;
+    return openvdb::Vec2s(d_new, capped_ ? std::min<float>(w_new, weight_cap_) : w_new);
+  }
 
   // Re-marches the given leaves (in parallel) and replaces their surface samples; returns
   // each leaf's mesh (empty where the leaf holds no surface).
@@ -33,6 +45,8 @@ class FusedGrid {
  private:
   double voxel_;
   float min_weight_;
+  bool capped_;
+  float weight_cap_;
   DistanceWeightGrid::Ptr grid_;
   SurfaceCache cache_;
 };

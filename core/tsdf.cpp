@@ -29,7 +29,8 @@ void TsdfConfig::validate() const {
 }
 
 Tsdf::Tsdf(TsdfConfig config)
-    : config_(validated(config)), fused_(config.voxel, static_cast<float>(config.min_weight)) {}
+    : config_(validated(config)),
+      fused_(config.voxel, static_cast<float>(config.min_weight), config.weight_cap) {}
 
 void Tsdf::integrate(const Frame& frame) {
   check_pose(frame);
@@ -39,7 +40,6 @@ void Tsdf::integrate(const Frame& frame) {
       world_points(frame, config_.min_range, config_.max_range);
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
   const double voxel = config_.voxel, trunc = config_.truncation;
-  const bool capped = config_.weight_cap > 0.0;
 
   auto t0 = Clock::now();
   openvdb::MaskGrid touched(false);
@@ -63,10 +63,7 @@ void Tsdf::integrate(const Frame& frame) {
       const double sdf = (centre - origin).norm() - depth;  // positive behind the surface
       if (sdf >= trunc) continue;
       const float tsdf = static_cast<float>(std::max(sdf, -trunc));
-      const openvdb::Vec2s old = acc.getValue(ijk);
-      const float w = old[1] + 1.0f;
-      const float d = (old[0] * old[1] + tsdf) / w;
-      acc.setValue(ijk, openvdb::Vec2s(d, capped ? std::min<float>(w, config_.weight_cap) : w));
+      acc.setValue(ijk, fused_.weighted_average(acc.getValue(ijk), openvdb::Vec2s(tsdf, 1.0f)));
       touch.setValueOn(ijk);
     } while (dda.step());
   }

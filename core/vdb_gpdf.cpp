@@ -133,13 +133,11 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
 // ray carves only a voxel whose centre it passes within kNearCarveReach voxels, so a centre
 // it wrongly calls free is at most that deep; leaving those voxels uncarved instead made the
 // surface's linear extension run past silhouettes (readings too near doubled).
-openvdb::MaskGrid near_surface(const PointSumGrid& local, double global_voxel) {
-  openvdb::MaskGrid mask(false);
+void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskGrid& mask) {
   auto acc = mask.getAccessor();
   for (auto v = local.cbeginValueOn(); v; ++v) acc.setValueOn(voxel_of(centroid(*v), global_voxel));
   openvdb::tools::dilateActiveValues(mask.tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                      openvdb::tools::IGNORE_TILES);
-  return mask;
 }
 
 // Rays converge on the sensor, so near it thousands of them cross the same voxel: each crossed
@@ -179,6 +177,212 @@ std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
   return out;
 }
 
+// The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
+// GP training points and (after train_local_gps) its GP, and the global voxels near the
+// frame's surface.
+struct LocalFrame {
+  PointSumGrid points{openvdb::Vec4f(0.0f)};
+  LocalGps gps;
+  std::vector<std::vector<Eigen::Vector3f>> training;
+  openvdb::MaskGrid near{false};
+};
+
+// Stage "voxelise". Training points are the centroids of the frame's points per local voxel,
+// not the voxel centres: centres put a face up to half a local voxel inside or outside it.
+void voxelise(const VdbGpdfConfig& config, const std::vector<Eigen::Vector3d>& points, LocalFrame& out) {
+  {
+    auto acc = out.points.getAccessor();
+    for (const auto& p : points) {
+      const openvdb::Coord c = voxel_of(p, config.local_voxel);
+      acc.setValue(c, acc.getValue(c) + openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f));
+    }
+  }
+  out.gps.voxel = config.local_voxel;
+  for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) {
+    std::vector<Eigen::Vector3f> pts;
+    int i = 0;
+    for (auto v = leaf->cbeginValueOn(); v; ++v, ++i)
+      if (i % config.voxel_downsample == 0) pts.push_back(centroid(*v).cast<float>());
+    out.gps.index.emplace(leaf->origin(), static_cast<int>(out.gps.origins.size()));
+    out.gps.origins.push_back(leaf->origin());
+    out.gps.centres.push_back(leaf_centre(leaf->origin(), config.local_voxel));
+    out.training.push_back(std::move(pts));
+  }
+  near_surface(out.points, config.global_voxel, out.near);
+}
+
+// Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
+void train_local_gps(const GpParams& params, LocalFrame& local) {
+  local.gps.gps.resize(local.training.size());
+  parallel_for_each_index(local.training.size(),
+                          [&](size_t i) { local.gps.gps[i].train(local.training[i], params); });
+}
+
+// One local leaf's query points and their signed distances (negative in free space, positive
+// behind) from the nearest local GP, and the observed global voxels its rays cross. A query
+// point's value is moved to the centre of the voxel it falls in by first order (value +
+// signed gradient . (centre - q)): the marching cubes read values at voxel centres, and
+// binning the raw values would shift the surface by up to half a voxel (measured: 0.8 voxel
+// worst case on a sphere).
+class LeafQueries {
+ public:
+  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
+              size_t leaf, const Eigen::Vector3d& origin)
+      : config_(config), local_(local), leaf_(leaf), origin_(origin), vg_(config.global_voxel),
+        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()),
+        near_acc_(local.near.getConstAccessor()) {}
+
+  std::vector<QueryUpdate> updates;
+  std::vector<openvdb::Coord> carved;
+
+  // A training point p of this leaf: p itself, points behind it and in front of it, its ray.
+  void add(const Eigen::Vector3d& p) {
+    Eigen::Vector3d u = origin_ - p;
+    const double range = u.norm();
+    if (!(range > 0.0)) return;
+    u /= range;  // toward the sensor: the direction the query points are placed along
+    const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
+    {
+      // p is a centroid inside this leaf, so this leaf's GP is its nearest: no lookup.
+      const GpPrediction pred = local_.gps.gps[leaf_].predict(p, config_.inverse_variance_fusion);
+      const double d = pred.valid ? pred.distance : 0.0;
+      fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
+           pred.valid ? pred.variance : config_.variance_on_surface, true);
+    }
+    // Behind points along the normal, not the ray (behind points along a grazing ray leave
+    // thin objects), and only where the normal is trusted: a view within 6 degrees of the
+    // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
+    if (normal.dot(u) > kMinNormalDotRay)
+      for (int j = 1; j <= config_.trunc_behind; ++j) fuse_query(p - j * config_.query_step * normal, 1.0);
+    // Front points along the ray: the ray crossed that space, so it is free for sure.
+    for (int j = 1; j <= config_.trunc_front; ++j) fuse_query(p + j * config_.query_step * u, -1.0);
+    if (config_.free_space_carving) carve(p, u, range);
+  }
+
+ private:
+  // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
+  void fuse(const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
+            double variance, bool hit) {
+    const openvdb::Coord v = voxel_of(q, vg_);
+    const double at_centre = value + toward_inside.dot(voxel_centre(v, vg_) - q);
+    const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
+    updates.push_back({v, static_cast<float>(at_centre), weight, hit});
+  }
+
+  // sign: +1 behind the surface, -1 in front of it.
+  void fuse_query(const Eigen::Vector3d& q, double sign) {
+    const int gp = local_.gps.nearest(q);
+    if (gp < 0) return;
+    // Each local GP knows only its own patch, so its distance is an upper bound: take the
+    // smaller of the nearest leaf's and the source point's own leaf's (the leaf nearest by
+    // centre can hold a patch far from q's foot point; measured on a sphere: front/carve
+    // value RMSE 2.0 -> 1.1 cm).
+    GpPrediction pred = local_.gps.gps[gp].predict(q, config_.inverse_variance_fusion);
+    if (gp != static_cast<int>(leaf_)) {
+      const GpPrediction own = local_.gps.gps[leaf_].predict(q, config_.inverse_variance_fusion);
+      if (own.valid && (!pred.valid || own.distance < pred.distance)) pred = own;
+    }
+    if (!pred.valid) return;  // f <= 0: no distance, skipped
+    fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0);
+  }
+
+  // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
+  // the sensor: fixed steps along fixed rays (a static camera) can skip a voxel forever, and
+  // then a moved object is never carved there. Two levels: leaf blocks first, voxels only
+  // inside blocks that exist (observed voxels lie near surfaces, so most of a ray crosses no
+  // block at all).
+  void carve(const Eigen::Vector3d& p, const Eigen::Vector3d& u, double range) {
+    using Ray = openvdb::math::Ray<double>;
+    const double start = config_.carving_step;
+    if (range <= start) return;
+    const Eigen::Vector3d s0 = (p + start * u) / vg_;
+    const Ray ray(openvdb::Vec3d(s0.x(), s0.y(), s0.z()), openvdb::Vec3d(u.x(), u.y(), u.z()), 0.0,
+                  (range - start) / vg_);
+    const double near_reach = kNearCarveReach * vg_;
+    openvdb::math::DDA<Ray, 3> blocks(ray);
+    do {
+      const openvdb::Coord block = blocks.voxel();
+      if (!observed_.probeConstLeaf(block)) continue;
+      Ray inside(ray);
+      inside.setTimes(blocks.time(), std::min(blocks.next(), ray.t1()));
+      openvdb::math::DDA<Ray, 0> dda(inside);
+      do {
+        const openvdb::Coord v = dda.voxel();
+        // A voxel on the block's edge may round into the neighbour: that block visits it.
+        if (leaf_origin_of(v) != block || !(observed_.getValue(v)[1] > 0.0f)) continue;
+        if (near_acc_.isValueOn(v) && (voxel_centre(v, vg_) - p).cross(u).norm() > near_reach) continue;
+        carved.push_back(v);
+      } while (dda.step());
+    } while (blocks.step());
+  }
+
+  const VdbGpdfConfig& config_;
+  const LocalFrame& local_;
+  size_t leaf_;
+  Eigen::Vector3d origin_;
+  double vg_;
+  DistanceWeightGrid::ConstAccessor observed_;
+  PointSumGrid::ConstAccessor local_acc_;
+  openvdb::MaskGrid::ConstAccessor near_acc_;
+};
+
+// Stage "query_points": every local leaf's query updates, then the carving updates last.
+std::vector<std::vector<QueryUpdate>> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
+                                                    const DistanceWeightGrid& fused,
+                                                    const Eigen::Vector3d& origin) {
+  const size_t leaves = local.training.size();
+  std::vector<std::vector<QueryUpdate>> updates(leaves);
+  std::vector<std::vector<openvdb::Coord>> carved(leaves);  // voxels each leaf's rays cross
+  parallel_for_each_index(leaves, [&](size_t leaf) {
+    LeafQueries queries(config, local, fused, leaf, origin);
+    for (const auto& p : local.training[leaf]) queries.add(p.cast<double>());
+    updates[leaf] = std::move(queries.updates);
+    carved[leaf] = std::move(queries.carved);
+  });
+  updates.push_back(carving_updates(config, carved, local.gps));
+  return updates;
+}
+
+// Stage "fusion": sums the frame's updates per voxel (in a fixed order) into `frame_sums`, then
+// blends each touched voxel once by the fusion rule. Without a cap this equals one
+// running-average update per query point.
+void fuse_updates(const VdbGpdfConfig& config, const std::vector<std::vector<QueryUpdate>>& updates,
+                  FusedGrid& fused, DistanceWeightGrid& frame_sums) {
+  openvdb::MaskGrid hits(false);
+  {
+    auto acc = frame_sums.getAccessor();
+    auto hit_acc = hits.getAccessor();
+    for (const auto& leaf_updates : updates)
+      for (const auto& u : leaf_updates) {
+        const openvdb::Vec2s v = acc.getValue(u.voxel);
+        acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
+        if (u.hit) hit_acc.setValueOn(u.voxel);
+      }
+  }
+  auto acc = fused.grid().getAccessor();
+  auto hit_acc = hits.getConstAccessor();
+  const float vacated_below = static_cast<float>(-kVacatedVoxels * config.global_voxel);
+  for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
+    for (auto v = leaf->cbeginValueOn(); v; ++v) {
+      const openvdb::Vec2s sum = *v;
+      const openvdb::Vec2s old = acc.getValue(v.getCoord());
+      // Space the map knew as behind a surface that this frame sees only as free, by more
+      // than a voxel on average (so not the inside of a thin wall seen from its other side):
+      // the object has left, and this frame's value replaces the old one at once instead of
+      // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
+      // voxels only the floor's front queries reach, took 20 frames to clear).
+      const bool vacated = old[0] > 0.0f && !hit_acc.isValueOn(v.getCoord()) && sum[0] < vacated_below * sum[1];
+      acc.setValue(v.getCoord(), fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
+    }
+}
+
+// Runs one stage and records its wall time under `name`.
+template <class Stage>
+void timed(StageTimes& times, const char* name, Stage&& stage) {
+  const auto t0 = Clock::now();
+  stage();
+  times.stages.emplace_back(name, ms_since(t0));
+}
 }  // namespace
 
 // A global leaf's GP over its zero crossings, trained at the first query that needs it.
@@ -239,7 +443,7 @@ double carving_frame_bound(double weight_cap, double d_old, double carve) {
 
 VdbGpdf::VdbGpdf(VdbGpdfConfig config)
     : config_(validated(config)),
-      fused_(config.global_voxel, static_cast<float>(config.recon_min_weight)) {}
+      fused_(config.global_voxel, static_cast<float>(config.recon_min_weight), config.weight_cap) {}
 
 VdbGpdf::~VdbGpdf() = default;
 
@@ -247,185 +451,16 @@ void VdbGpdf::integrate(const Frame& frame) {
   check_pose(frame);
   times_.stages.clear();
   const auto t_start = Clock::now();
-  const std::vector<Eigen::Vector3d> points =
-      world_points(frame, config_.min_range, config_.max_range);
+  const std::vector<Eigen::Vector3d> points = world_points(frame, config_.min_range, config_.max_range);
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
-  const GpParams gp_params = config_.gp_params();
-
-  // 1. Local grid and one GP per leaf (trained in parallel; each writes only its own slot).
-  auto t0 = Clock::now();
-  // Training points are the centroids of the frame's points per local voxel, not the voxel
-  // centres: centres put a face up to half a local voxel inside or outside the object.
-  PointSumGrid local(openvdb::Vec4f(0.0f));
-  {
-    auto acc = local.getAccessor();
-    for (const auto& p : points) {
-      const openvdb::Coord c = voxel_of(p, config_.local_voxel);
-      acc.setValue(c, acc.getValue(c) + openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f));
-    }
-  }
-  LocalGps locals;
-  locals.voxel = config_.local_voxel;
-  std::vector<std::vector<Eigen::Vector3f>> training;
-  for (auto leaf = local.tree().cbeginLeaf(); leaf; ++leaf) {
-    std::vector<Eigen::Vector3f> pts;
-    int i = 0;
-    for (auto v = leaf->cbeginValueOn(); v; ++v, ++i)
-      if (i % config_.voxel_downsample == 0)
-        pts.push_back(centroid(*v).cast<float>());
-    locals.index.emplace(leaf->origin(), static_cast<int>(locals.origins.size()));
-    locals.origins.push_back(leaf->origin());
-    locals.centres.push_back(leaf_centre(leaf->origin(), config_.local_voxel));
-    training.push_back(std::move(pts));
-  }
-  const openvdb::MaskGrid near = near_surface(local, config_.global_voxel);
-  times_.stages.emplace_back("voxelise", ms_since(t0));
-  t0 = Clock::now();
-  locals.gps.resize(training.size());
-  parallel_for_each_index(training.size(),
-                          [&](size_t i) { locals.gps[i].train(training[i], gp_params); });
-  times_.stages.emplace_back("local_gps", ms_since(t0));
-
-  // 2-3. Query points and their signed distances (negative in free space, positive behind),
-  // from the nearest local GP. A query point's value is moved to the centre of the voxel it
-  // falls in by first order (value + signed gradient . (centre - q)): the marching cubes read
-  // values at voxel centres, and binning the raw values would shift the surface by up to half
-  // a voxel (measured: 0.8 voxel worst case on a sphere).
-  t0 = Clock::now();
-  std::vector<std::vector<QueryUpdate>> updates(training.size());
-  std::vector<std::vector<openvdb::Coord>> carved(training.size());  // voxels each leaf's rays cross
-  parallel_for_each_index(training.size(), [&](size_t leaf) {
-    auto observed = fused_.grid().getConstAccessor();
-    auto local_acc = local.getConstAccessor();
-    auto near_acc = near.getConstAccessor();
-    auto& out = updates[leaf];
-    const double vg = config_.global_voxel;
-    // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
-    auto fuse = [&](const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
-                    double variance, bool hit) {
-      const openvdb::Coord v = voxel_of(q, vg);
-      const double at_centre = value + toward_inside.dot(voxel_centre(v, vg) - q);
-      const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
-      out.push_back({v, static_cast<float>(at_centre), weight, hit});
-    };
-    // sign: +1 behind the surface, -1 in front of it.
-    auto fuse_query = [&](const Eigen::Vector3d& q, double sign) {
-      const int gp = locals.nearest(q);
-      if (gp < 0) return;
-      // Each local GP knows only its own patch, so its distance is an upper bound: take the
-      // smaller of the nearest leaf's and the source point's own leaf's (the leaf nearest by
-      // centre can hold a patch far from q's foot point; measured on a sphere: front/carve
-      // value RMSE 2.0 -> 1.1 cm).
-      GpPrediction pred = locals.gps[gp].predict(q, config_.inverse_variance_fusion);
-      if (gp != static_cast<int>(leaf)) {
-        const GpPrediction own = locals.gps[leaf].predict(q, config_.inverse_variance_fusion);
-        if (own.valid && (!pred.valid || own.distance < pred.distance)) pred = own;
-      }
-      if (!pred.valid) return;  // f <= 0: no distance, skipped
-      fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0);
-    };
-    for (const auto& pf : training[leaf]) {
-      const Eigen::Vector3d p = pf.cast<double>();
-      Eigen::Vector3d u = origin - p;
-      const double range = u.norm();
-      if (!(range > 0.0)) continue;
-      u /= range;  // toward the sensor: the direction the query points are placed along
-      const Eigen::Vector3d normal =
-          surface_normal(local_acc, voxel_of(p, config_.local_voxel), p, u);
-      {
-        // p is a centroid inside this leaf, so this leaf's GP is its nearest: no lookup.
-        const GpPrediction pred = locals.gps[leaf].predict(p, config_.inverse_variance_fusion);
-        const double d = pred.valid ? pred.distance : 0.0;
-        fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
-             pred.valid ? pred.variance : config_.variance_on_surface, true);
-      }
-      // Behind points along the normal, not the ray (behind points along a grazing ray leave
-      // thin objects), and only where the normal is trusted: a view within 6 degrees of the
-      // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
-      if (normal.dot(u) > kMinNormalDotRay)
-        for (int j = 1; j <= config_.trunc_behind; ++j)
-          fuse_query(p - j * config_.query_step * normal, 1.0);
-      // Front points along the ray: the ray crossed that space, so it is free for sure.
-      for (int j = 1; j <= config_.trunc_front; ++j)
-        fuse_query(p + j * config_.query_step * u, -1.0);
-      if (!config_.free_space_carving) continue;
-      // Every observed global voxel the ray crosses (DDA) from one carving step in front of p
-      // to the sensor: fixed steps along fixed rays (a static camera) can skip a voxel
-      // forever, and then a moved object is never carved there.
-      using Ray = openvdb::math::Ray<double>;
-      const double start = config_.carving_step;
-      if (range <= start) continue;
-      const Eigen::Vector3d s0 = (p + start * u) / vg;
-      const Ray ray(openvdb::Vec3d(s0.x(), s0.y(), s0.z()), openvdb::Vec3d(u.x(), u.y(), u.z()),
-                    0.0, (range - start) / vg);
-      // Two levels: leaf blocks first, voxels only inside blocks that exist (observed voxels
-      // lie near surfaces, so most of a ray crosses no block at all).
-      const double near_reach = kNearCarveReach * vg;
-      openvdb::math::DDA<Ray, 3> blocks(ray);
-      do {
-        const openvdb::Coord block = blocks.voxel();
-        if (!observed.probeConstLeaf(block)) continue;
-        Ray inside(ray);
-        inside.setTimes(blocks.time(), std::min(blocks.next(), ray.t1()));
-        openvdb::math::DDA<Ray, 0> dda(inside);
-        do {
-          const openvdb::Coord v = dda.voxel();
-          // A voxel on the block's edge may round into the neighbour: that block visits it.
-          if (leaf_origin_of(v) != block || !(observed.getValue(v)[1] > 0.0f)) continue;
-          if (near_acc.isValueOn(v) && (voxel_centre(v, vg) - p).cross(u).norm() > near_reach) continue;
-          carved[leaf].push_back(v);
-        } while (dda.step());
-      } while (blocks.step());
-    }
-  });
-  updates.push_back(carving_updates(config_, carved, locals));
-  times_.stages.emplace_back("query_points", ms_since(t0));
-
-  // 4. Fusion: sum the frame's updates per voxel (in a fixed order), then blend each touched
-  // voxel once. Without a cap this equals one running-average update per query point.
-  t0 = Clock::now();
+  LocalFrame local;
+  std::vector<std::vector<QueryUpdate>> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
-  openvdb::MaskGrid hits(false);
-  {
-    auto acc = frame_sums.getAccessor();
-    auto hit_acc = hits.getAccessor();
-    for (const auto& leaf_updates : updates)
-      for (const auto& u : leaf_updates) {
-        const openvdb::Vec2s v = acc.getValue(u.voxel);
-        acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
-        if (u.hit) hit_acc.setValueOn(u.voxel);
-      }
-  }
-  {
-    auto acc = fused_.grid().getAccessor();
-    auto hit_acc = hits.getConstAccessor();
-    const bool capped = config_.weight_cap > 0.0;
-    const float vacated_below = static_cast<float>(-kVacatedVoxels * config_.global_voxel);
-    for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
-      for (auto v = leaf->cbeginValueOn(); v; ++v) {
-        const openvdb::Vec2s sum = *v;
-        const openvdb::Vec2s old = acc.getValue(v.getCoord());
-        // Space the map knew as behind a surface that this frame sees only as free, by more
-        // than a voxel on average (so not the inside of a thin wall seen from its other side):
-        // the object has left, and this frame's value replaces the old one at once instead of
-        // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
-        // voxels only the floor's front queries reach, took 20 frames to clear).
-        const bool vacated = old[0] > 0.0f && !hit_acc.isValueOn(v.getCoord()) &&
-                             sum[0] < vacated_below * sum[1];
-        const float w_old = vacated ? 0.0f : old[1];
-        const float w_new = w_old + sum[1];
-        const float d_new = (old[0] * w_old + sum[0]) / w_new;
-        acc.setValue(v.getCoord(),
-                     openvdb::Vec2s(d_new, capped ? std::min<float>(w_new, config_.weight_cap)
-                                                  : w_new));
-      }
-  }
-  times_.stages.emplace_back("fusion", ms_since(t0));
-
-  // 5. G-GPDF and surface samples for the touched leaves.
-  t0 = Clock::now();
-  update_global_field(frame_sums);
-  times_.stages.emplace_back("g_gpdf", ms_since(t0));
+  timed(times_, "voxelise", [&] { voxelise(config_, points, local); });
+  timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
+  timed(times_, "query_points", [&] { updates = query_updates(config_, local, fused_.grid(), origin); });
+  timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });
+  timed(times_, "g_gpdf", [&] { update_global_field(frame_sums); });
   times_.stages.emplace_back("total", ms_since(t_start));
 }
 

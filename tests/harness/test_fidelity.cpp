@@ -290,8 +290,9 @@ TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far tha
   check_classes({kCorner, kLow, kThin});
 }
 
-// Open (issue 13): VDB-GPDF still misses 5 grazing bins against the peer's 4 and 1 vacated bin
-// against 0 (docs/fidelity.md). Hidden from CTest until it passes; run it with
+// Open (issue 13): VDB-GPDF still misses 5 grazing bins against the peer's 4 (bins clipping a
+// box's vertical edge, rounded by marching cubes) and 1 vacated bin against 0 (a far wall the
+// moved box uncovered, holes in its first sparse observation): docs/fidelity.md. Hidden from CTest until it passes; run it with
 // `test_harness "[fidelity-open]"`.
 TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
           "peer on grazing faces and where a box left",
