@@ -10,8 +10,6 @@
 
 namespace sonomap::harness {
 
-std::string code_version() { return std::string(SONOMAP_VERSION) + " (" SONOMAP_GIT_VERSION ")"; }
-
 int run_cli(int argc, char** argv) {
   CLI::App app{"sonomap: depth sensing -> online map -> 360-degree rasters -> binaural sound"};
   app.require_subcommand(1);

@@ -2,6 +2,8 @@
 // The `sonomap` command line: a thin layer over harness functions that tests can call.
 #pragma once
 
+#include "harness/support/version.hpp"
+
 #include <CLI/CLI.hpp>
 #include <string>
 
@@ -33,7 +35,5 @@ std::string key_reference_markdown();
 // 0 success, 2 bad input (message names file, line and key), 1 other failure.
 int run_cli(int argc, char** argv);
 
-// The code version recorded in every result ("0.1.0 (git describe)").
-std::string code_version();
 
 }  // namespace sonomap::harness

@@ -3,6 +3,7 @@
 
 #include "harness/support/errors.hpp"
 #include "harness/support/interrupt.hpp"
+#include "harness/support/version.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -149,7 +150,7 @@ void remove_stale_staging(const fs::path& folder) {
 }
 
 std::string marker_text(const std::string& command) {
-  return "sonomap " + command + " " + SONOMAP_VERSION + " (" + SONOMAP_GIT_VERSION + ")\n";
+  return "sonomap " + command + " " + code_version() + "\n";
 }
 
 // Renames `staging` to `final_path`; an existing final (checked to be ours) is swapped out in
