@@ -9,6 +9,7 @@
 #include "harness/app/run_results.hpp"
 #include "harness/app/run_setup.hpp"
 #include "harness/app/sonify.hpp"
+#include "harness/app/video_maker.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/fields.hpp"
 #include "harness/support/interrupt.hpp"
@@ -91,6 +92,10 @@ RunOutcome run_scenario(const RunOptions& options) {
   FrameOutputs outputs(staged.path(), options, schedule, source.name(), mapper->name(),
                        inputs.settings.raster);
   Rasteriser rasteriser(inputs.settings.raster);
+  std::optional<RunVideo> video;
+  if (options.video)
+    video.emplace(staged.path(), source.name(), mapper->name(), inputs.settings.raster,
+                  schedule.frame_count(), SweepClock{});
   std::vector<Eigen::Vector3f> surface;
   Progress progress("run " + source.name(), schedule.frame_count(), options.quiet);
   for (int i = 0; i < schedule.frame_count(); ++i) {
@@ -108,7 +113,9 @@ RunOutcome run_scenario(const RunOptions& options) {
                            &rasteriser.cylinder(), &surface, &evaluation};
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
       outputs.write(view);
+      if (video) video->add_rasters(view);
     }
+    if (video) video->add_frame(sensed.frame);
     results.add_timings(i, times);
     progress.update(i + 1);
   }
@@ -117,6 +124,7 @@ RunOutcome run_scenario(const RunOptions& options) {
   RunSummary summary = describe_run(options, inputs, *mapper);
   results.fill_metrics(summary, inputs.settings.edf_enabled);
   summary.sweeps = outputs.sweep_levels();
+  if (video) video->finish(std::nullopt);
   results.finish(summary, *mapper);
   staged.commit();
   return RunOutcome{options.out, summary};
@@ -188,6 +196,9 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--brir", options->brir_dir,
                   "BRIR directory for the sweeps (default: synthesise the room from the map)");
   cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
+  cmd->add_flag("--video", options->video,
+                 "Write run.mp4 (needs the ffmpeg program): depth image, circle with the sector\n"
+                 "being played, map from above with the path, time and metrics, per frame");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
   cmd->footer(run_keys_help());
   cmd->callback([options, &global] {
