@@ -65,12 +65,12 @@ Canvas RunVideo::draw(const Frame& frame) const {
   canvas.text(8, h + 4, "MAP FROM ABOVE, NORTH UP, AND THE PATH", kTitle);
   std::vector<std::string> lines{
       fmt::format("{} / {}", scenario_, mapper_),
-      fmt::format("FRAME {} OF {}   T = {:.2f} S", frame.index + 1, frame_count_, frame.time),
+      fmt::format("FRAME {} OF 0-{}   T = {:.2f} S", frame.index, frame_count_ - 1, frame.time),
       sector < 0 ? std::string("SWEEP: PAUSE")
                  : fmt::format("SWEEP: SECTOR {} ({}-{} DEG LEFT OF AHEAD)", sector,
                                sector * 360 / clock_.sectors, (sector + 1) * 360 / clock_.sectors)};
   if (rasters_frame_ >= 0) {
-    lines.push_back(fmt::format("METRICS OF FRAME {}", rasters_frame_ + 1));
+    lines.push_back(fmt::format("METRICS OF FRAME {}", rasters_frame_));
     lines.push_back(metric_line("CIRCLE", circle_metrics_, has_truth_));
     lines.push_back(metric_line("CYLINDER", cylinder_metrics_, has_truth_));
   }
