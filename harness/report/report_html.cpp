@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/report/report_html.hpp"
 
+#include "harness/report/claims.hpp"
 #include "harness/support/output.hpp"
 
 #include <fmt/format.h>
@@ -14,20 +15,6 @@ namespace fs = std::filesystem;
 
 namespace sonomap::harness {
 namespace {
-
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 // A relative URL for a path under the report folder: each byte outside the unreserved set
 // percent-encoded, '/' kept.
@@ -60,15 +47,15 @@ std::vector<fs::path> files(const fs::path& root, const fs::path& sub, const std
 std::string audio_player(const fs::path& wav, const std::string& label) {
   return fmt::format("<figure><figcaption>{}</figcaption><audio controls preload=\"metadata\" "
                      "src=\"{}\"></audio></figure>\n",
-                     escaped(label), url(wav));
+                     xml_escape(label), url(wav));
 }
 
 // One run: its video, its listening stream, its sweeps and its pictures.
 std::string run_section(const fs::path& dir, const HtmlRun& run) {
   const fs::path rel = fs::path("runs") / run.id;
   std::ostringstream html;
-  html << "<section class=\"run\"><h3>" << escaped(run.variant) << "</h3>\n<p>run <code>"
-       << escaped(run.id) << "</code>, mapper " << escaped(run.mapper) << "</p>\n";
+  html << "<section class=\"run\"><h3>" << xml_escape(run.variant) << "</h3>\n<p>run <code>"
+       << xml_escape(run.id) << "</code>, mapper " << xml_escape(run.mapper) << "</p>\n";
   if (fs::is_regular_file(dir / rel / "run.mp4"))
     html << "<video controls preload=\"metadata\" width=\"640\" src=\"" << url(rel / "run.mp4")
          << "\"></video>\n";
@@ -77,8 +64,8 @@ std::string run_section(const fs::path& dir, const HtmlRun& run) {
   for (const fs::path& wav : files(dir, rel / "sweeps", ".wav"))
     html << audio_player(wav, "sweep " + wav.filename().string());
   for (const fs::path& png : files(dir, rel / "pictures", ".png"))
-    html << "<figure><img src=\"" << url(png) << "\" alt=\"" << escaped(png.filename().string())
-         << "\"><figcaption>" << escaped(png.filename().string()) << "</figcaption></figure>\n";
+    html << "<figure><img src=\"" << url(png) << "\" alt=\"" << xml_escape(png.filename().string())
+         << "\"><figcaption>" << xml_escape(png.filename().string()) << "</figcaption></figure>\n";
   html << "</section>\n";
   return html.str();
 }
@@ -97,19 +84,19 @@ void write_report_html(const fs::path& dir, const std::vector<HtmlRun>& runs) {
   for (const HtmlRun& r : runs) walks[{r.scenario, r.seed}].push_back(&r);
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>sonomap report: "
-       << escaped(dir.filename().string()) << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n"
-       << "<h1>sonomap report: " << escaped(dir.filename().string()) << "</h1>\n"
+       << xml_escape(dir.filename().string()) << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n"
+       << "<h1>sonomap report: " << xml_escape(dir.filename().string()) << "</h1>\n"
        << "<p>" << runs.size() << " runs. Tables and numbers: <a href=\"report.md\">report.md</a>, "
        << "<a href=\"rollup.csv\">rollup.csv</a>.</p>\n";
   for (const auto& [walk, list] : walks) {
-    html << "<h2>" << escaped(walk.first) << ", seed " << walk.second << "</h2>\n<div class=\"walk\">\n";
+    html << "<h2>" << xml_escape(walk.first) << ", seed " << walk.second << "</h2>\n<div class=\"walk\">\n";
     for (const HtmlRun* r : list) html << run_section(dir, *r);
     html << "</div>\n";
   }
   const std::vector<fs::path> plots = files(dir, "plots", ".png");
   if (!plots.empty()) html << "<h2>Plots</h2>\n";
   for (const fs::path& png : plots)
-    html << "<figure><img src=\"" << url(png) << "\" alt=\"" << escaped(png.filename().string())
+    html << "<figure><img src=\"" << url(png) << "\" alt=\"" << xml_escape(png.filename().string())
          << "\"></figure>\n";
   html << "</body></html>\n";
   write_text_file(dir / "report.html", html.str());

@@ -20,6 +20,20 @@
 extern char** environ;
 
 namespace sonomap::harness {
+namespace {
+
+// posix_spawnp of argv (looked up in PATH) with `actions`, which it destroys; 0 or an errno.
+int spawn(pid_t& pid, const std::vector<std::string>& argv, posix_spawn_file_actions_t& actions,
+          const posix_spawnattr_t* attributes = nullptr) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const int error = ::posix_spawnp(&pid, args[0], &actions, attributes, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return error;
+}
+
+}  // namespace
 
 int run_program(const std::vector<std::string>& argv, std::string* output) {
   if (argv.empty()) return -1;
@@ -32,12 +46,8 @@ int run_program(const std::vector<std::string>& argv, std::string* output) {
   posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
 
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int spawn_error = spawn(pid, argv, actions);
   ::close(pipe_fds[1]);
 
   std::string captured;
@@ -64,12 +74,8 @@ int run_program_with_timeout(const std::vector<std::string>& argv, double timeou
   posix_spawnattr_init(&attributes);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attributes, 0);  // its own group: a timeout ends its children too
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int spawn_error = spawn(pid, argv, actions, &attributes);
   posix_spawnattr_destroy(&attributes);
   if (spawn_error != 0) return -1;
 
@@ -125,12 +131,8 @@ PipedProgram::PipedProgram(const std::vector<std::string>& argv) {
   posix_spawn_file_actions_adddup2(&actions, in_fds[0], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&actions, out_fds[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, out_fds[1], STDERR_FILENO);
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int spawn_error = spawn(pid, argv, actions);
   ::close(in_fds[0]);
   ::close(out_fds[1]);
   stdin_fd_ = in_fds[1];
