@@ -50,7 +50,8 @@ void RunVideo::add_rasters(const FrameView& view) {
   cylinder_metrics_ = view.evaluation->cylinder;
   has_truth_ = view.evaluation->has_truth;
   rasters_frame_ = view.index;
-  top_view_.add_surface(*view.surface);
+  top_view_.add_surface(*view.surface, view.origin.ground_z + raster_.band_min,
+                        view.origin.ground_z + raster_.band_max);
 }
 
 Canvas RunVideo::draw(const Frame& frame) const {

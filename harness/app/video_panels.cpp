@@ -73,9 +73,9 @@ void draw_circle(Canvas& canvas, const PanelRect& r, const Circle& circle,
   canvas.line(cx, cy, cx, cy - 0.5 * metres, kInk);  // straight ahead, half a metre
 }
 
-void TopView::add_surface(const std::vector<Eigen::Vector3f>& points) {
+void TopView::add_surface(const std::vector<Eigen::Vector3f>& points, double z_min, double z_max) {
   for (const Eigen::Vector3f& p : points) {
-    if (!p.allFinite()) continue;
+    if (!p.allFinite() || p.z() < z_min || p.z() > z_max) continue;
     const long x = std::lround(p.x() / cell_m_), y = std::lround(p.y() / cell_m_);
     if (!cells_.insert(cell_key(x, y)).second) continue;
     extend(Eigen::Vector2d(x * cell_m_, y * cell_m_));

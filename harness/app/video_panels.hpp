@@ -31,12 +31,13 @@ void draw_depth(Canvas& canvas, const PanelRect& r, const Frame& frame, double m
 void draw_circle(Canvas& canvas, const PanelRect& r, const Circle& circle,
                  const RasterConfig& config, int sector, int sectors);
 
-// The map seen from above, north up: every surface cell seen so far, the path and the
-// listener's position and heading now.
+// The map seen from above, north up: every surface cell seen so far in the obstacle band (the
+// heights the rasters look at: no floor or ceiling), the path and the listener now.
 class TopView {
  public:
   explicit TopView(double cell_m = 0.05) : cell_m_(cell_m) {}
-  void add_surface(const std::vector<Eigen::Vector3f>& points);
+  // Points with z in [z_min, z_max] (world) are kept.
+  void add_surface(const std::vector<Eigen::Vector3f>& points, double z_min, double z_max);
   void add_pose(const Eigen::Vector2d& position, double heading);
   void draw(Canvas& canvas, const PanelRect& r) const;
 
