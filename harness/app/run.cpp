@@ -124,7 +124,10 @@ RunOutcome run_scenario(const RunOptions& options) {
   RunSummary summary = describe_run(options, inputs, *mapper);
   results.fill_metrics(summary, inputs.settings.edf_enabled);
   summary.sweeps = outputs.sweep_levels();
-  if (video) video->finish(std::nullopt);
+  if (video) {  // the listening stream, when the run wrote one, is the sound track
+    const fs::path stream = staged.path() / "listen.wav";
+    video->finish(fs::is_regular_file(stream) ? std::optional<fs::path>(stream) : std::nullopt);
+  }
   results.finish(summary, *mapper);
   staged.commit();
   return RunOutcome{options.out, summary};
