@@ -10,6 +10,7 @@
 #include "harness/app/run_results.hpp"
 #include "harness/app/run_setup.hpp"
 #include "harness/app/sonify.hpp"
+#include "harness/app/video_maker.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/fields.hpp"
 #include "harness/support/interrupt.hpp"
@@ -95,8 +96,13 @@ RunOutcome run_scenario(const RunOptions& options) {
   FrameOutputs outputs(staged.path(), options, schedule, source.name(), mapper->name(),
                        inputs.settings.raster);
   std::optional<ListenStep> listen;  // --listen: listen.wav, the stream over the whole run
-  if (options.listen) listen.emplace(staged.path(), options, inputs.settings.listen, source.head());
+  if (options.listen || options.video) listen.emplace(staged.path(), options, inputs.settings.listen, source.head());
   Rasteriser rasteriser(inputs.settings.raster);
+  std::optional<RunVideo> video;
+  if (options.video)
+    video.emplace(staged.path(), source.name(), mapper->name(), inputs.settings.raster,
+                  schedule.frame_count(),
+                  SweepClock{inputs.settings.listen.stream.period_s, inputs.settings.listen.stream.pause_s, 36});
   std::vector<Eigen::Vector3f> surface;
   Progress progress("run " + source.name(), schedule.frame_count(), options.quiet);
   for (int i = 0; i < schedule.frame_count(); ++i) {
@@ -115,7 +121,9 @@ RunOutcome run_scenario(const RunOptions& options) {
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
       outputs.write(view);
       if (listen) listen->add(view);
+      if (video) video->add_rasters(view);
     }
+    if (video) video->add_frame(sensed.frame);
     results.add_timings(i, times);
     progress.update(i + 1);
   }
@@ -125,6 +133,8 @@ RunOutcome run_scenario(const RunOptions& options) {
   results.fill_metrics(summary, inputs.settings.edf_enabled);
   summary.sweeps = outputs.sweep_levels();
   if (listen) summary.listen = listen->finish(schedule.frame_count());
+  if (video)  // the listening stream is the sound track (--video implies --listen)
+    video->finish(std::optional<fs::path>(staged.path() / kListenWav));
   results.finish(summary, *mapper);
   staged.commit();
   return RunOutcome{options.out, summary};
@@ -199,6 +209,10 @@ void add_run_command(CLI::App& app, const GlobalOptions& global) {
                 "Write listen.wav: the binaural stream a wearer hears over the whole run, sweeps "
                 "every listen.period (docs/sonification.md)");
   cmd->add_option("--tag", options->tags, "key=value label recorded in summary.json");
+  cmd->add_flag("--video", options->video,
+                 "Write run.mp4 (needs the ffmpeg program): depth image, circle with the sector\n"
+                 "being played, map from above with the path, time and metrics, per frame; its sound\n"
+                 "track is listen.wav (implies --listen)");
   cmd->add_flag("!--no-rasters", options->write_rasters, "Do not write circle.csv / cylinder.csv");
   cmd->footer(run_keys_help());
   cmd->callback([options, &global] {

@@ -6,6 +6,7 @@
 //   core/rasterise_map, eval/evaluate_frame   the per-frame computation
 //   run_results    frames.csv, circle.csv, cylinder.csv, edf.csv, timings, summary.json
 //   frame_outputs  pictures/ and sweeps/ for the chosen frames
+//   video_maker    run.mp4 (--video)
 #pragma once
 
 #include "harness/app/cli.hpp"
@@ -39,6 +40,7 @@ struct RunOptions {
   std::filesystem::path brir_dir;
   bool write_rasters = true;
   bool listen = false;  // listen.wav and listen_events.csv (harness/app/listen_step.hpp)
+  bool video = false;  // run.mp4 (harness/app/video_maker.hpp)
   bool quiet = false;
   // "key=value" labels recorded in summary.json (compare uses scenario=..., variant=...).
   std::vector<std::string> tags;

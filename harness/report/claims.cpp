@@ -133,8 +133,6 @@ std::string gates_section(const std::vector<Claim>& gates, const RollupTable& ro
   return md.str();
 }
 
-namespace {
-
 std::string xml_escape(const std::string& text) {
   std::string out;
   for (char c : text) {
@@ -149,6 +147,8 @@ std::string xml_escape(const std::string& text) {
   }
   return out;
 }
+
+namespace {
 
 // One <testsuite>: a gate fails when it does not hold or is not measured; a claim that
 // differs or is not measured is skipped (a finding, not a failure).

@@ -62,6 +62,9 @@ std::string claims_section(const std::vector<Claim>& claims, const RollupTable& 
 // The report's "Gates" section; `failed` counts the gates that fail or are not measured.
 std::string gates_section(const std::vector<Claim>& gates, const RollupTable& rollup, int& failed);
 
+// Text with &, <, >, " and ' as XML (and HTML) entities.
+std::string xml_escape(const std::string& text);
+
 // JUnit XML: a test suite of gates (failure when one fails or is not measured) and one of
 // claims (a claim that differs from the paper is a finding, reported as skipped, not failed).
 std::string junit_xml(const std::vector<Claim>& claims, const std::vector<Claim>& gates,

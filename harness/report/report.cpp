@@ -5,6 +5,7 @@
 #include "harness/formats/run_summary.hpp"
 
 #include "harness/report/pictures.hpp"
+#include "harness/report/report_html.hpp"
 #include "harness/report/rollup.hpp"
 #include "harness/report/stats_report.hpp"
 #include "harness/support/errors.hpp"
@@ -295,9 +296,12 @@ ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& juni
     md << scenario_plots(dir, scenario, list, stages);
   }
   write_text_file(dir / "report.md", md.str());
+  std::vector<HtmlRun> html_runs;
+  for (const RunRecord& r : runs) html_runs.push_back({r.id, r.scenario, r.variant, r.mapper, r.seed});
+  write_report_html(dir, html_runs);
   if (!quiet)
-    std::printf("report: %zu runs -> %s, %s, %s\n", runs.size(), (dir / "rollup.csv").c_str(),
-                (dir / "report.md").c_str(), (dir / "plots").c_str());
+    std::printf("report: %zu runs -> %s, %s, %s, %s\n", runs.size(), (dir / "rollup.csv").c_str(),
+                (dir / "report.md").c_str(), (dir / "report.html").c_str(), (dir / "plots").c_str());
   if (outcome.failed_gates > 0)
     std::fprintf(stderr, "report: %d of %zu gates fail (see %s)\n", outcome.failed_gates, gates.size(),
                  (dir / "report.md").c_str());
@@ -319,7 +323,7 @@ void add_report_command(CLI::App& app, const GlobalOptions& global) {
     if (!is_sonomap_result(*dir)) {
       if (!fs::is_directory(*dir / "runs"))
         throw InputError(dir->string() + " is not a sonomap result and holds no runs/");
-      for (const char* name : {"rollup.csv", "rollup_stats.csv", "pairs.csv", "report.md", "plots"})
+      for (const char* name : {"rollup.csv", "rollup_stats.csv", "pairs.csv", "report.md", "report.html", "plots"})
         if (fs::exists(*dir / name))
           throw InputError((*dir / name).string() + " exists and was not written by sonomap; "
                            "report writes only into a folder `sonomap compare` made");

@@ -11,11 +11,29 @@
 #include <thread>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
 
 extern char** environ;
 
 namespace sonomap::harness {
+namespace {
+
+// posix_spawnp of argv (looked up in PATH) with `actions`, which it destroys; 0 or an errno.
+int spawn(pid_t& pid, const std::vector<std::string>& argv, posix_spawn_file_actions_t& actions,
+          const posix_spawnattr_t* attributes = nullptr) {
+  std::vector<char*> args;
+  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  const int error = ::posix_spawnp(&pid, args[0], &actions, attributes, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return error;
+}
+
+}  // namespace
 
 int run_program(const std::vector<std::string>& argv, std::string* output) {
   if (argv.empty()) return -1;
@@ -28,12 +46,8 @@ int run_program(const std::vector<std::string>& argv, std::string* output) {
   posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
 
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int spawn_error = spawn(pid, argv, actions);
   ::close(pipe_fds[1]);
 
   std::string captured;
@@ -60,12 +74,8 @@ int run_program_with_timeout(const std::vector<std::string>& argv, double timeou
   posix_spawnattr_init(&attributes);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attributes, 0);  // its own group: a timeout ends its children too
-  std::vector<char*> args;
-  for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, args[0], &actions, &attributes, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
+  const int spawn_error = spawn(pid, argv, actions, &attributes);
   posix_spawnattr_destroy(&attributes);
   if (spawn_error != 0) return -1;
 
@@ -86,6 +96,91 @@ int run_program_with_timeout(const std::vector<std::string>& argv, double timeou
   }
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
+}  // namespace sonomap::harness
+
+namespace sonomap::harness {
+
+bool program_in_path(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  std::string folders = path ? path : "";
+  size_t start = 0;
+  while (start <= folders.size()) {
+    const size_t end = std::min(folders.find(':', start), folders.size());
+    const std::string folder = folders.substr(start, end - start);
+    const std::string candidate = (folder.empty() ? "." : folder) + "/" + program;
+    if (::access(candidate.c_str(), X_OK) == 0) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+PipedProgram::PipedProgram(const std::vector<std::string>& argv) {
+  int in_fds[2], out_fds[2];
+  if (argv.empty() || ::pipe2(in_fds, O_CLOEXEC) != 0) throw std::runtime_error("cannot make a pipe");
+  if (::pipe2(out_fds, O_CLOEXEC) != 0) {
+    ::close(in_fds[0]);
+    ::close(in_fds[1]);
+    throw std::runtime_error("cannot make a pipe");
+  }
+  // A program that stops reading must not end sonomap with SIGPIPE: write() reports it.
+  std::signal(SIGPIPE, SIG_IGN);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, in_fds[0], STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, out_fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, out_fds[1], STDERR_FILENO);
+  pid_t pid = 0;
+  const int spawn_error = spawn(pid, argv, actions);
+  ::close(in_fds[0]);
+  ::close(out_fds[1]);
+  stdin_fd_ = in_fds[1];
+  output_fd_ = out_fds[0];
+  if (spawn_error != 0) {
+    ::close(stdin_fd_);
+    ::close(output_fd_);
+    throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(spawn_error));
+  }
+  pid_ = pid;
+  reader_ = std::thread([this] {
+    char buffer[4096];
+    ssize_t n;
+    while ((n = ::read(output_fd_, buffer, sizeof buffer)) > 0) output_.append(buffer, n);
+  });
+}
+
+PipedProgram::~PipedProgram() {
+  if (pid_ > 0) ::kill(pid_, SIGKILL);
+  finish();
+}
+
+bool PipedProgram::write(const void* data, size_t bytes) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0 && stdin_fd_ >= 0) {
+    const ssize_t n = ::write(stdin_fd_, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    bytes -= static_cast<size_t>(n);
+  }
+  return stdin_fd_ >= 0;
+}
+
+int PipedProgram::finish(std::string* output) {
+  if (stdin_fd_ >= 0) ::close(stdin_fd_);
+  stdin_fd_ = -1;
+  int status = -1;
+  if (pid_ > 0) {
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+  }
+  if (reader_.joinable()) reader_.join();
+  if (output_fd_ >= 0) ::close(output_fd_);
+  output_fd_ = -1;
+  if (output) *output = output_;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace sonomap::harness

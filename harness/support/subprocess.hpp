@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace sonomap::harness {
@@ -16,5 +17,30 @@ int run_program(const std::vector<std::string>& argv, std::string* output = null
 // group is killed. Returns the exit status (128 + signal when killed by one), -1 when the
 // program could not be started; `timed_out` tells whether the time limit ended it.
 int run_program_with_timeout(const std::vector<std::string>& argv, double timeout_s, bool& timed_out);
+
+// Whether `program` is an executable file in one of PATH's folders.
+bool program_in_path(const std::string& program);
+
+// A program fed through its stdin (ffmpeg reading raw video frames), without a shell; its
+// stdout and stderr are captured. Not started: throws std::runtime_error. Destroyed before
+// finish(): the program is killed (a failed run leaves no encoder behind).
+class PipedProgram {
+ public:
+  explicit PipedProgram(const std::vector<std::string>& argv);
+  ~PipedProgram();
+  PipedProgram(const PipedProgram&) = delete;
+  PipedProgram& operator=(const PipedProgram&) = delete;
+  // False once the program has stopped reading (it exited or failed).
+  bool write(const void* data, size_t bytes);
+  // Closes its stdin and waits; the exit status (-1 when killed by a signal), `output` filled.
+  int finish(std::string* output = nullptr);
+
+ private:
+  int pid_ = -1;
+  int stdin_fd_ = -1;
+  int output_fd_ = -1;
+  std::string output_;
+  std::thread reader_;  // drains stdout/stderr so the program never blocks on them
+};
 
 }  // namespace sonomap::harness
