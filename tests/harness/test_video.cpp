@@ -49,7 +49,8 @@ bool have_ffmpeg() {
 
 }  // namespace
 
-TEST_CASE("run --video: one picture per sensor frame at the sensor's rate, the run's length",
+TEST_CASE("run --video: one picture per sensor frame at the sensor's rate, the run's length, "
+          "and listen.wav as its sound track, as long as the video within one frame",
           "[video]") {
   if (!have_ffmpeg()) SONOMAP_SKIP("ffmpeg/ffprobe not installed (ci/install-deps installs them)");
   ScratchDir scratch("video-run");
@@ -66,6 +67,12 @@ TEST_CASE("run --video: one picture per sensor frame at the sensor's rate, the r
   CHECK(std::stoi(video.at("nb_read_frames")) == frames);
   CHECK(rate_of(video.at("r_frame_rate")) == Approx(kSmokeRateHz));
   CHECK(std::stod(video.at("duration")) == Approx(frames / kSmokeRateHz).margin(0.5 / kSmokeRateHz));
+  // --video implies --listen: the stream the wearer hears is the sound track.
+  CHECK(fs::is_regular_file(o.out / "listen.wav"));
+  const auto audio = probe(mp4, "a:0");
+  REQUIRE(audio.count("duration"));
+  CHECK(audio.at("codec_type") == "audio");
+  CHECK(std::stod(audio.at("duration")) == Approx(std::stod(video.at("duration"))).margin(1.0 / kSmokeRateHz));
 }
 
 TEST_CASE("run --video: two runs give byte-identical run.mp4", "[video][determinism]") {
