@@ -297,7 +297,7 @@ ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& juni
   }
   write_text_file(dir / "report.md", md.str());
   std::vector<HtmlRun> html_runs;
-  for (const RunRecord& r : runs) html_runs.push_back({r.id, r.scenario, r.variant, r.mapper, r.seed});
+  for (const RunRecord& r : runs) html_runs.push_back({r.id, r.scenario, r.variant, r.mapper, r.summary.seed});
   write_report_html(dir, html_runs);
   if (!quiet)
     std::printf("report: %zu runs -> %s, %s, %s, %s\n", runs.size(), (dir / "rollup.csv").c_str(),

@@ -46,7 +46,7 @@ std::string head(const std::string& entry) {
 TEST_CASE("every command's --help shows the default of every option that has one", "[help]") {
   // Optional inputs with nothing to default to (the scenario's own seed is --seed's).
   const std::set<std::string> no_default = {"--circle", "--cylinder", "--command", "--junit", "--json", "--seed"};
-  for (const std::vector<std::string> command :
+  for (const std::vector<std::string>& command :
        {std::vector<std::string>{"run"}, {"compare"}, {"report"}, {"render"}, {"brir"}, {"sonify"},
         {"score"}, {"diff"}, {"keys"}, {"bench", "map"}, {"bench", "sonify"}, {"bench", "render"}}) {
     std::vector<std::string> args = command;
