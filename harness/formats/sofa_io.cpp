@@ -3,7 +3,9 @@
 
 #include "audio/resample.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/interrupt.hpp"
 #include "harness/support/output.hpp"
+#include "harness/support/subprocess.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -82,11 +84,38 @@ Eigen::Matrix3d head_frame(const MYSOFA_HRTF& h) {
   return m;  // NaN when view and up are parallel or zero
 }
 
+// Debian's HDF5 1.10 frees an invalid pointer on some corrupt files (found by the sanitizer
+// suite on a mutated default.sofa) and libmysofa can loop on others: the file is first opened
+// by both readers in a child process, so a crash or a hang there becomes a clear error here.
+// A file they refuse cleanly is refused again below, with their message.
+void screen_in_child(const fs::path& file) {
+  constexpr double kTimeoutS = 30.0;
+  constexpr int kOpens = 0, kRefused = 10;
+  bool timed_out = false;
+  const int status = run_isolated(
+      [&] {
+        int ncid = 0;
+        if (nc_open(file.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return kRefused;
+        nc_close(ncid);
+        int err = 0;
+        MYSOFA_HRTF* hrtf = mysofa_load(file.c_str(), &err);
+        if (hrtf) mysofa_free(hrtf);
+        return hrtf && err == MYSOFA_OK ? kOpens : kRefused;
+      },
+      kTimeoutS, timed_out);
+  throw_if_interrupted();
+  if (timed_out) bad(file, "the SOFA readers did not finish within 30 s (a corrupt file)");
+  if (status != kOpens && status != kRefused)
+    bad(file, "the SOFA readers (HDF5, libmysofa) crashed on it (a corrupt file; exit status " +
+                  std::to_string(status) + ")");
+}
+
 }  // namespace
 
 SofaContents read_sofa(const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) bad(file, "not a readable file");
+  screen_in_child(file);
   // libmysofa 1.3.1 can loop for minutes on a corrupt HDF5 file (found by fuzz/fuzz_sofa);
   // netCDF's HDF5 reader refuses such files at once, so it checks the container first.
   int ncid = 0;

@@ -33,6 +33,30 @@ int spawn(pid_t& pid, const std::vector<std::string>& argv, posix_spawn_file_act
   return error;
 }
 
+
+// Waits for `pid`; past `timeout_s` or on Ctrl-C (interrupt.hpp) sends SIGKILL to `kill_target`
+// (the pid, or minus its process group). The exit status, 128 + signal when a signal ended it,
+// -1 when waiting failed.
+int wait_with_deadline(pid_t pid, pid_t kill_target, double timeout_s, bool& timed_out) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  int status = 0;
+  for (;;) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) return -1;
+    const bool late = std::chrono::steady_clock::now() >= deadline;
+    if (late || interrupt_requested()) {
+      timed_out = late;
+      ::kill(kill_target, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
 }  // namespace
 
 int run_program(const std::vector<std::string>& argv, std::string* output) {
@@ -79,23 +103,22 @@ int run_program_with_timeout(const std::vector<std::string>& argv, double timeou
   posix_spawnattr_destroy(&attributes);
   if (spawn_error != 0) return -1;
 
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  int status = 0;
-  for (;;) {
-    const pid_t done = ::waitpid(pid, &status, WNOHANG);
-    if (done == pid) break;
-    if (done < 0 && errno != EINTR) return -1;
-    const bool late = std::chrono::steady_clock::now() >= deadline;
-    if (late || interrupt_requested()) {
-      timed_out = late;
-      ::kill(-pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      break;
+  return wait_with_deadline(pid, -pid, timeout_s, timed_out);
+}
+
+int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed_out) {
+  timed_out = false;
+  const pid_t pid = ::fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {  // the child: no destructors, atexit handlers or stdio flushes of the parent's
+    int code = 127;
+    try {
+      code = work();
+    } catch (...) {
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ::_exit(code);
   }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+  return wait_with_deadline(pid, pid, timeout_s, timed_out);
 }
 
 }  // namespace sonomap::harness

@@ -2,6 +2,7 @@
 // Running helper programs (gnuplot) without a shell, so paths with spaces or quotes are safe.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -17,6 +18,12 @@ int run_program(const std::vector<std::string>& argv, std::string* output = null
 // group is killed. Returns the exit status (128 + signal when killed by one), -1 when the
 // program could not be started; `timed_out` tells whether the time limit ended it.
 int run_program_with_timeout(const std::vector<std::string>& argv, double timeout_s, bool& timed_out);
+
+// Runs `work` in a forked child process and returns its result as the child's exit status (128 +
+// signal when it crashed, 127 when it threw, -1 when no child could be made). For library code
+// that may crash or loop on hostile input (HDF5 on a corrupt SOFA file): the crash stays in the
+// child. Past `timeout_s` or on Ctrl-C the child is killed; `timed_out` tells which.
+int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed_out);
 
 // Whether `program` is an executable file in one of PATH's folders.
 bool program_in_path(const std::string& program);
