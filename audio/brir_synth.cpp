@@ -412,6 +412,7 @@ BrirSet BrirSynthesizer::synthesize(const BrirGrid& grid, const StopRequested& s
     if (stop && stop()) return;
     irs[i] = synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]);
   });
+  if (stop && stop()) return BrirSet{};  // skipped points: an empty set the caller discards
   return BrirSet(config_.sample_rate, grid, std::move(irs));
 }
 
@@ -426,6 +427,7 @@ BrirSet BrirSynthesizer::synthesize_on_demand(std::shared_ptr<const BrirSynthesi
     if (stop && stop()) return;
     loudest[i] = loudest_ear_energy(self->synthesize(grid.azimuths_deg[i % na], grid.distances_m[i / na]));
   });
+  if (stop && stop()) return BrirSet{};
   const double max_energy = *std::max_element(loudest.begin(), loudest.end());
   const double factor = max_energy > 0.0 ? 1.0 / std::sqrt(max_energy) : 1.0;
   auto make = [self, grid, factor](size_t d, size_t a) {

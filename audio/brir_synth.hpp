@@ -84,7 +84,7 @@ class BrirSynthesizer {
   // horizontal `distance_m` from the head, at ear height.
   BinauralIr synthesize(double azimuth_deg, double distance_m) const;
   // A caller's "give up now" test, polled before each grid point (e.g. a pending signal); once
-  // it returns true the remaining points are skipped and the set must be discarded.
+  // it returns true the remaining points are skipped and an empty set is returned.
   using StopRequested = std::function<bool()>;
 
   // The whole grid (parallel over grid points; the result does not depend on thread count).
