@@ -49,7 +49,8 @@ class DevTools:
 
     def __init__(self, url):
         import websocket  # Debian: python3-websocket
-        self.ws = websocket.create_connection(url, timeout=30)
+        # No Origin header: Chromium refuses DevTools connections from unlisted origins (403).
+        self.ws = websocket.create_connection(url, timeout=30, suppress_origin=True)
         self.next_id = 0
         self.events = []
 
@@ -95,7 +96,7 @@ def open_in_chromium(chromium, page):
     profile = tempfile.mkdtemp(prefix="sonomap-chromium-")
     browser = subprocess.Popen(
         [chromium, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
-         "--remote-debugging-port=0", "--remote-debugging-address=127.0.0.1",
+         "--remote-debugging-port=0", "--remote-debugging-address=127.0.0.1", "--remote-allow-origins=*",
          "--user-data-dir=" + profile, "about:blank"],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     try:
