@@ -2,6 +2,7 @@
 #include "core/vdb_gpdf.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <openvdb/math/DDA.h>
 #include <openvdb/math/Ray.h>
 #include <openvdb/tools/Morphology.h>
@@ -22,7 +23,14 @@ namespace {
 using Clock = StageClock;
 
 constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
-constexpr double kNearCarveReach = 0.25;  // voxels; see near_surface()
+// A surface point's negative value is dropped at a centre the camera saw more than this many
+// voxels behind the measured surface (see LeafQueries::fuse).
+constexpr double kBehindMargin = 0.25;
+// A global voxel without a training point gets a query source of its own only when its
+// frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
+// a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
+// along its diagonal, tests/core/test_circle_fidelity.cpp).
+constexpr int kMinSparseCells = 3;
 // A voxel the map holds as behind a surface that this frame sees only as free, by more than
 // this many voxels on average, has been vacated: an object left.
 constexpr double kVacatedVoxels = 1.0;
@@ -48,6 +56,63 @@ struct QueryUpdate {
   bool hit = false;  // from a surface point or behind it (not from free space in front)
 };
 
+// The frame's depth image seen from the world: whether a point lies in front of (or behind)
+// what the camera measured along its line of sight. A ray proves free only the space it crosses, but a
+// query or carving value lands at a voxel centre up to 0.87 voxel away, which beside an edge
+// seen at a grazing angle can lie inside the object: then its negative value rounds the edge
+// off (random box rooms: bins clipping a box's vertical edge read the wall behind). Near the
+// surface a centre gets a free-space value only if its pixel and their 8 neighbours (mixed
+// pixels at silhouettes report the far side) all measured something farther. Frames without
+// a depth image (point clouds) skip the check.
+class DepthView {
+ public:
+  explicit DepthView(const Frame& frame)
+      : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
+        usable_(frame.intrinsics.valid() && frame.width > 0 && frame.height > 0 &&
+                frame.depth.size() == static_cast<size_t>(frame.width) * frame.height) {}
+
+  // In the image, and every measured depth of its pixel and the 8 around it is farther.
+  bool seen_in_front(const Eigen::Vector3d& world) const {
+    if (!usable_) return true;
+    int u = 0, v = 0;
+    double z = 0.0;
+    if (!pixel_of(world, u, v, z)) return false;
+    for (int y = std::max(v - 1, 0); y <= std::min(v + 1, frame_.height - 1); ++y)
+      for (int x = std::max(u - 1, 0); x <= std::min(u + 1, frame_.width - 1); ++x) {
+        const float d = depth_at(x, y);
+        if (d > 0.0f && d <= z) return false;
+      }
+    return true;
+  }
+
+  // In the image, and its own pixel measured a surface more than `margin` nearer.
+  bool seen_behind(const Eigen::Vector3d& world, double margin) const {
+    int u = 0, v = 0;
+    double z = 0.0;
+    if (!usable_ || !pixel_of(world, u, v, z)) return false;
+    const float d = depth_at(u, v);
+    return d > 0.0f && d < z - margin;
+  }
+
+ private:
+  bool pixel_of(const Eigen::Vector3d& world, int& u, int& v, double& z) const {
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    if (!(c.z() > 0.0)) return false;
+    const PinholeIntrinsics& k = frame_.intrinsics;
+    const double pu = std::round(k.fx * c.x() / c.z() + k.cx), pv = std::round(k.fy * c.y() / c.z() + k.cy);
+    if (!(pu >= 0.0 && pv >= 0.0 && pu < frame_.width && pv < frame_.height)) return false;
+    u = static_cast<int>(pu);
+    v = static_cast<int>(pv);
+    z = c.z();
+    return true;
+  }
+  float depth_at(int u, int v) const { return frame_.depth[static_cast<size_t>(v) * frame_.width + u]; }
+
+  const Frame& frame_;
+  Eigen::Isometry3d camera_T_world_;
+  bool usable_;
+};
+
 // The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
 // one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
 // of its 26 neighbours; else the nearest of all (rare: points far from every surface).
@@ -55,8 +120,30 @@ struct LocalGps {
   double voxel = 0.02;
   std::vector<openvdb::Coord> origins;
   std::vector<Eigen::Vector3d> centres;
+  std::vector<Eigen::AlignedBox3d> bounds;  // of each GP's training points
   std::vector<SurfaceGp> gps;
   std::unordered_map<openvdb::Coord, int, CoordHash> index;
+  std::vector<std::vector<int>> neighbours;  // per leaf, its neighbouring leaves (of 26)
+
+  // Once every leaf is indexed: most queries lie in a leaf, and then smallest() reads its
+  // neighbours from here instead of 26 lookups.
+  void link_neighbours() {
+    neighbours.assign(origins.size(), {});
+    for (size_t i = 0; i < origins.size(); ++i)
+      for_each_neighbour(origins[i], [&](int j) { neighbours[i].push_back(j); });
+  }
+
+  // Calls f(index) for every leaf among the 26 around the leaf at `home`.
+  template <typename F>
+  void for_each_neighbour(const openvdb::Coord& home, F&& f) const {
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          auto it = index.find(home.offsetBy(dx * kLeafDim, dy * kLeafDim, dz * kLeafDim));
+          if (it != index.end()) f(it->second);
+        }
+  }
 
   int nearest(const Eigen::Vector3d& q) const {
     const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
@@ -70,14 +157,37 @@ struct LocalGps {
         best = i;
       }
     };
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          auto it = index.find(home.offsetBy(dx * kLeafDim, dy * kLeafDim, dz * kLeafDim));
-          if (it != index.end()) consider(it->second);
-        }
+    for_each_neighbour(home, consider);
     if (best >= 0) return best;
     for (int i = 0; i < static_cast<int>(centres.size()); ++i) consider(i);
+    return best;
+  }
+
+  // The smallest distance the local GPs predict at q. Each GP knows only its own patch, so its
+  // distance is an upper bound: a surface just across a leaf border is invisible to the
+  // nearest leaf's GP, which then calls a voxel beside a box's edge several centimetres deep
+  // in free space and the edge is carved off. Besides the nearest GP (and `own`, a source
+  // point's leaf), every neighbouring leaf whose training points' box is nearer than the best
+  // distance so far (the box, not the leaf's cube: most neighbours are then skipped unasked).
+  GpPrediction smallest(const Eigen::Vector3d& q, bool with_variance, int own = -1) const {
+    GpPrediction best;
+    auto consider = [&](int i) {
+      const GpPrediction p = gps[i].predict(q, with_variance);
+      if (p.valid && (!best.valid || p.distance < best.distance)) best = p;
+    };
+    const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
+    const auto in_leaf = index.find(home);
+    const int first = in_leaf != index.end() ? in_leaf->second : nearest(q);
+    if (first < 0) return best;
+    consider(first);
+    if (own >= 0 && own != first) consider(own);
+    auto consider_if_near = [&](int i) {
+      if (i != first && i != own && (!best.valid || bounds[i].exteriorDistance(q) < best.distance)) consider(i);
+    };
+    if (in_leaf != index.end())
+      for (int i : neighbours[first]) consider_if_near(i);
+    else
+      for_each_neighbour(home, consider_if_near);
     return best;
   }
 };
@@ -129,10 +239,8 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
 // crosses can lie up to 0.87 voxel off it, so next to a surface that centre can be behind the
 // surface. Rays grazing past a silhouette edge, a corner or a thin top carved the object's own
 // inside, hundreds of rays against one or two surface samples, and the circle lost the edge
-// (room, 300 frames: 69 bin readings too far by over 0.1 m, TSDF peer 15). Near the surface a
-// ray carves only a voxel whose centre it passes within kNearCarveReach voxels, so a centre
-// it wrongly calls free is at most that deep; leaving those voxels uncarved instead made the
-// surface's linear extension run past silhouettes (readings too near doubled).
+// (room, 300 frames: 69 bin readings too far by over 0.1 m, TSDF peer 15). In these voxels a
+// free-space value needs the depth image's word that the centre is free (DepthView).
 void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskGrid& mask) {
   auto acc = mask.getAccessor();
   for (auto v = local.cbeginValueOn(); v; ++v) acc.setValueOn(voxel_of(centroid(*v), global_voxel));
@@ -143,10 +251,11 @@ void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskG
 // Rays converge on the sensor, so near it thousands of them cross the same voxel: each crossed
 // voxel is queried once, at its centre, and fused with one unit of weight per ray that crossed
 // it (what one carving point per ray and voxel would give, at a fraction of the GP queries:
-// measured 5x fewer on the room).
+// measured 5x fewer on the room). Near the surface only centres the depth image saw free.
 std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
                                          const std::vector<std::vector<openvdb::Coord>>& carved,
-                                         const LocalGps& locals) {
+                                         const LocalGps& locals, const openvdb::MaskGrid& near,
+                                         const DepthView& view) {
   openvdb::Int32Grid counts(0);
   {
     auto acc = counts.getAccessor();
@@ -161,9 +270,8 @@ std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
   const double vg = config.global_voxel;
   parallel_for_each_index(voxels.size(), [&](size_t i) {
     const Eigen::Vector3d q = voxel_centre(voxels[i].first, vg);
-    const int gp = locals.nearest(q);
-    if (gp < 0) return;
-    const GpPrediction pred = locals.gps[gp].predict(q, config.inverse_variance_fusion);
+    if (near.tree().isValueOn(voxels[i].first) && !view.seen_in_front(q)) return;
+    const GpPrediction pred = locals.smallest(q, config.inverse_variance_fusion);
     if (!pred.valid) return;
     const double rays = voxels[i].second;
     const double weight = config.inverse_variance_fusion ? rays / pred.variance : rays;
@@ -184,8 +292,35 @@ struct LocalFrame {
   PointSumGrid points{openvdb::Vec4f(0.0f)};
   LocalGps gps;
   std::vector<std::vector<Eigen::Vector3f>> training;
+  // Per local leaf the points queries are placed around: its training points, and one
+  // centroid in every global voxel holding frame points in kMinSparseCells local voxels or
+  // more but no training point (a far surface, a pixel per local voxel, would otherwise be
+  // fused in patches).
+  std::vector<std::vector<Eigen::Vector3f>> sources;
   openvdb::MaskGrid near{false};
 };
+
+void add_sparse_sources(double global_voxel, LocalFrame& local) {
+  // Per global voxel: how many local voxels hold points; -1 once it has a source.
+  openvdb::Int32Grid counts(0);
+  auto count = counts.getAccessor();
+  for (auto v = local.points.cbeginValueOn(); v; ++v) {
+    const openvdb::Coord g = voxel_of(centroid(*v), global_voxel);
+    count.setValue(g, count.getValue(g) + 1);
+  }
+  for (const auto& leaf_points : local.training)
+    for (const auto& p : leaf_points) count.setValue(voxel_of(p.cast<double>(), global_voxel), -1);
+  local.sources = local.training;
+  size_t leaf_index = 0;
+  for (auto leaf = local.points.tree().cbeginLeaf(); leaf; ++leaf, ++leaf_index)
+    for (auto v = leaf->cbeginValueOn(); v; ++v) {
+      const Eigen::Vector3d c = centroid(*v);
+      const openvdb::Coord g = voxel_of(c, global_voxel);
+      if (count.getValue(g) < kMinSparseCells) continue;
+      count.setValue(g, -1);
+      local.sources[leaf_index].push_back(c.cast<float>());
+    }
+}
 
 // Stage "voxelise". Training points are the centroids of the frame's points per local voxel,
 // not the voxel centres: centres put a face up to half a local voxel inside or outside it.
@@ -206,9 +341,14 @@ void voxelise(const VdbGpdfConfig& config, const std::vector<Eigen::Vector3d>& p
     out.gps.index.emplace(leaf->origin(), static_cast<int>(out.gps.origins.size()));
     out.gps.origins.push_back(leaf->origin());
     out.gps.centres.push_back(leaf_centre(leaf->origin(), config.local_voxel));
+    Eigen::AlignedBox3d box;
+    for (const auto& p : pts) box.extend(p.cast<double>());
+    out.gps.bounds.push_back(box);
     out.training.push_back(std::move(pts));
   }
+  out.gps.link_neighbours();
   near_surface(out.points, config.global_voxel, out.near);
+  add_sparse_sources(config.global_voxel, out);
 }
 
 // Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
@@ -226,9 +366,9 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
 // worst case on a sphere).
 class LeafQueries {
  public:
-  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
-              size_t leaf, const Eigen::Vector3d& origin)
-      : config_(config), local_(local), leaf_(leaf), origin_(origin), vg_(config.global_voxel),
+  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DepthView& view,
+              const DistanceWeightGrid& fused, size_t leaf, const Eigen::Vector3d& origin)
+      : config_(config), local_(local), view_(view), leaf_(leaf), origin_(origin), vg_(config.global_voxel),
         observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()),
         near_acc_(local.near.getConstAccessor()) {}
 
@@ -247,7 +387,7 @@ class LeafQueries {
       const GpPrediction pred = local_.gps.gps[leaf_].predict(p, config_.inverse_variance_fusion);
       const double d = pred.valid ? pred.distance : 0.0;
       fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
-           pred.valid ? pred.variance : config_.variance_on_surface, true);
+           pred.valid ? pred.variance : config_.variance_on_surface, Source::surface);
     }
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
@@ -260,30 +400,31 @@ class LeafQueries {
   }
 
  private:
+  enum class Source { surface, behind, front };
+
   // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
   void fuse(const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
-            double variance, bool hit) {
+            double variance, Source source) {
     const openvdb::Coord v = voxel_of(q, vg_);
-    const double at_centre = value + toward_inside.dot(voxel_centre(v, vg_) - q);
+    const Eigen::Vector3d centre = voxel_centre(v, vg_);
+    const double at_centre = value + toward_inside.dot(centre - q);
+    // Near the surface a free-space value needs the depth image's word for it. A surface
+    // point's value moved along a normal that an edge tilts can call free a centre the camera
+    // saw behind the surface, and a front point beside a grazing face a centre inside it.
+    if (source == Source::surface && at_centre < 0.0 && view_.seen_behind(centre, kBehindMargin * vg_)) return;
+    if (source == Source::front && near_acc_.isValueOn(v) && !view_.seen_in_front(centre)) return;
+    const bool hit = source != Source::front;
     const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
     updates.push_back({v, static_cast<float>(at_centre), weight, hit});
   }
 
   // sign: +1 behind the surface, -1 in front of it.
   void fuse_query(const Eigen::Vector3d& q, double sign) {
-    const int gp = local_.gps.nearest(q);
-    if (gp < 0) return;
-    // Each local GP knows only its own patch, so its distance is an upper bound: take the
-    // smaller of the nearest leaf's and the source point's own leaf's (the leaf nearest by
-    // centre can hold a patch far from q's foot point; measured on a sphere: front/carve
-    // value RMSE 2.0 -> 1.1 cm).
-    GpPrediction pred = local_.gps.gps[gp].predict(q, config_.inverse_variance_fusion);
-    if (gp != static_cast<int>(leaf_)) {
-      const GpPrediction own = local_.gps.gps[leaf_].predict(q, config_.inverse_variance_fusion);
-      if (own.valid && (!pred.valid || own.distance < pred.distance)) pred = own;
-    }
+    // The source point's own leaf among the candidates: the leaf nearest by centre can hold a
+    // patch far from q's foot point (measured on a sphere: front/carve value RMSE 2.0 -> 1.1 cm).
+    const GpPrediction pred = local_.gps.smallest(q, config_.inverse_variance_fusion, static_cast<int>(leaf_));
     if (!pred.valid) return;  // f <= 0: no distance, skipped
-    fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0);
+    fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0 ? Source::behind : Source::front);
   }
 
   // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
@@ -298,7 +439,6 @@ class LeafQueries {
     const Eigen::Vector3d s0 = (p + start * u) / vg_;
     const Ray ray(openvdb::Vec3d(s0.x(), s0.y(), s0.z()), openvdb::Vec3d(u.x(), u.y(), u.z()), 0.0,
                   (range - start) / vg_);
-    const double near_reach = kNearCarveReach * vg_;
     openvdb::math::DDA<Ray, 3> blocks(ray);
     do {
       const openvdb::Coord block = blocks.voxel();
@@ -310,7 +450,6 @@ class LeafQueries {
         const openvdb::Coord v = dda.voxel();
         // A voxel on the block's edge may round into the neighbour: that block visits it.
         if (leaf_origin_of(v) != block || !(observed_.getValue(v)[1] > 0.0f)) continue;
-        if (near_acc_.isValueOn(v) && (voxel_centre(v, vg_) - p).cross(u).norm() > near_reach) continue;
         carved.push_back(v);
       } while (dda.step());
     } while (blocks.step());
@@ -318,6 +457,7 @@ class LeafQueries {
 
   const VdbGpdfConfig& config_;
   const LocalFrame& local_;
+  const DepthView& view_;
   size_t leaf_;
   Eigen::Vector3d origin_;
   double vg_;
@@ -328,18 +468,19 @@ class LeafQueries {
 
 // Stage "query_points": every local leaf's query updates, then the carving updates last.
 std::vector<std::vector<QueryUpdate>> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
+                                                    const DepthView& view,
                                                     const DistanceWeightGrid& fused,
                                                     const Eigen::Vector3d& origin) {
   const size_t leaves = local.training.size();
   std::vector<std::vector<QueryUpdate>> updates(leaves);
   std::vector<std::vector<openvdb::Coord>> carved(leaves);  // voxels each leaf's rays cross
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, fused, leaf, origin);
-    for (const auto& p : local.training[leaf]) queries.add(p.cast<double>());
+    LeafQueries queries(config, local, view, fused, leaf, origin);
+    for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
     updates[leaf] = std::move(queries.updates);
     carved[leaf] = std::move(queries.carved);
   });
-  updates.push_back(carving_updates(config, carved, local.gps));
+  updates.push_back(carving_updates(config, carved, local.gps, local.near, view));
   return updates;
 }
 
@@ -354,6 +495,7 @@ void fuse_updates(const VdbGpdfConfig& config, const std::vector<std::vector<Que
     auto hit_acc = hits.getAccessor();
     for (const auto& leaf_updates : updates)
       for (const auto& u : leaf_updates) {
+
         const openvdb::Vec2s v = acc.getValue(u.voxel);
         acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
         if (u.hit) hit_acc.setValueOn(u.voxel);
@@ -454,11 +596,12 @@ void VdbGpdf::integrate(const Frame& frame) {
   const std::vector<Eigen::Vector3d> points = world_points(frame, config_.min_range, config_.max_range);
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
   LocalFrame local;
+  const DepthView view(frame);
   std::vector<std::vector<QueryUpdate>> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
   timed(times_, "voxelise", [&] { voxelise(config_, points, local); });
   timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
-  timed(times_, "query_points", [&] { updates = query_updates(config_, local, fused_.grid(), origin); });
+  timed(times_, "query_points", [&] { updates = query_updates(config_, local, view, fused_.grid(), origin); });
   timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });
   timed(times_, "g_gpdf", [&] { update_global_field(frame_sums); });
   times_.stages.emplace_back("total", ms_since(t_start));
