@@ -159,36 +159,53 @@ SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float 
 }
 
 void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out) {
-  for (const auto& t : mesh.triangles) {
+  std::vector<int> divisions(mesh.triangles.size());
+  size_t count = 0;
+  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+    const Eigen::Vector3i& t = mesh.triangles[k];
     const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    const int n = std::max(1, static_cast<int>(std::ceil(longest / spacing)));
+    const int n = divisions[k] = std::max(1, static_cast<int>(std::ceil(longest / spacing)));
+    count += static_cast<size_t>(n + 1) * (n + 2) / 2;
+  }
+  out.reserve(out.size() + count);  // one allocation instead of a growing vector's many
+  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+    const Eigen::Vector3i& t = mesh.triangles[k];
+    const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    const int n = divisions[k];
     for (int i = 0; i <= n; ++i)
       for (int j = 0; j <= n - i; ++j)
         out.push_back(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n));
   }
 }
 
-std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched) {
+std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed) {
   std::vector<openvdb::Coord> out;
-  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf) {
-    const openvdb::Coord origin = leaf->origin();
-    out.push_back(origin);
+  for (const LeafChanges& leaf : changed) {
+    if (leaf.voxels.isOff()) continue;
+    out.push_back(leaf.origin);
     unsigned subsets = 0;  // bit s set: the lower neighbour along axis subset s is affected
-    for (auto v = leaf->cbeginValueOn(); v; ++v) {
-      const openvdb::Coord local = v.getCoord() - origin;
-      const unsigned m = (local.x() == 0) | (local.y() == 0) << 1 | (local.z() == 0) << 2;
+    for (auto v = leaf.voxels.beginOn(); v; ++v) {
+      const openvdb::Index i = v.pos();  // x << 6 | y << 3 | z
+      const unsigned m = ((i >> 6) == 0) | (((i >> 3) & 7) == 0) << 1 | ((i & 7) == 0) << 2;
       for (unsigned s = 1; s < 8; ++s)
         if ((s & m) == s) subsets |= 1u << s;
     }
     for (unsigned s = 1; s < 8; ++s)
       if (subsets & (1u << s))
-        out.push_back(origin.offsetBy((s & 1) ? -kLeafDim : 0, (s & 2) ? -kLeafDim : 0,
-                                      (s & 4) ? -kLeafDim : 0));
+        out.push_back(leaf.origin.offsetBy((s & 1) ? -kLeafDim : 0, (s & 2) ? -kLeafDim : 0,
+                                           (s & 4) ? -kLeafDim : 0));
   }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
+}
+
+std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched) {
+  std::vector<LeafChanges> changed;
+  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf)
+    changed.push_back({leaf->origin(), leaf->getValueMask()});
+  return dirty_leaves(changed);
 }
 
 void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples) {

@@ -66,10 +66,18 @@ SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float 
 // n = ceil(longest edge / spacing) and all their corners are emitted.
 void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out);
 
+// The voxels of one leaf (origin, one bit per voxel in the leaf's own order) that changed.
+using LeafMask = DistanceWeightGrid::TreeType::LeafNodeType::NodeMaskType;
+struct LeafChanges {
+  openvdb::Coord origin;
+  LeafMask voxels;
+};
+
 // Leaves that must be re-marched after the voxels in `touched` changed: each touched leaf and,
 // for voxels on a leaf's lower faces, the lower neighbours whose cubes reach into it.
 // Returned sorted (deterministic).
 std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched);
+std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed);
 
 // Dense surface samples per leaf of a grid, refreshed leaf by leaf, queried by a horizontal
 // disc so the cost follows the queried area, not the whole map.

@@ -1,8 +1,22 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The A/B peer of VDB-GPDF: a projective TSDF on OpenVDB in the style of VDBFusion. Each point
-// is traced with a DDA through the voxels from truncation in front of it (or from the sensor,
-// with space carving) to truncation behind it, and every voxel gets the truncated signed
-// distance along the ray in a running weighted average.
+// The A/B peer of VDB-GPDF: a projective TSDF on OpenVDB, fused with the one rule both maps use
+// (FusedGrid::weighted_average, weight capped) and surfaced by the shared marching cubes.
+//
+// A frame with a depth image and intrinsics is integrated projectively, as KinectFusion and
+// Open3D do: the voxel blocks (8^3 leaves) within the truncation band of the frame's points
+// are allocated, and with space carving also the blocks already in the map that lie in the
+// camera's frustum, so a moved object's old surface is carved away. Every voxel of those blocks
+// projects its centre into the nearest pixel; its signed distance is the distance along that
+// pixel's ray from the measured surface to the voxel centre (positive behind the surface), as
+// in the ray-traced path and in Open3D, so the band and the range limits mean the same in all
+// three. Beyond the truncation behind the surface a voxel is left alone; in front it is
+// truncated (with carving) or left alone (without). Each voxel gets at most one update of
+// weight 1 per frame. Blocks are fused in parallel, each by one task writing only its own
+// voxels, so the map does not depend on the thread count.
+//
+// A frame without a depth image (an unorganised cloud) falls back to ray tracing its points:
+// a DDA through the voxels from the truncation in front of each point (or from the sensor, with
+// space carving) to the truncation behind it, one update per ray and voxel.
 #pragma once
 
 #include "core/fused_grid.hpp"
@@ -13,8 +27,9 @@ namespace sonomap {
 struct TsdfConfig {
   double voxel = 0.05;       // m
   double truncation = 0.15;  // m (3 voxels)
-  // Trace from the sensor (on) or from truncation in front of the point (VDBFusion's default).
-  // On, like VDB-GPDF's free-space carving, so A/B runs compare like with like.
+  // Carve the observed free space in view (on) or fuse only the band around the surface
+  // (VDBFusion's default). On, like VDB-GPDF's free-space carving, so A/B runs compare like
+  // with like.
   bool space_carving = true;
   double weight_cap = 30.0;    // per-update weight ceiling (0 = none)
   double min_weight = 0.1;     // for queries and the surface
@@ -44,9 +59,17 @@ class Tsdf final : public Mapper {
   DistanceQuery query_point(const Eigen::Vector3f& x) const;
 
  private:
+  // Both return the voxels they changed.
+  std::vector<LeafChanges> integrate_image(const Frame& frame);
+  std::vector<LeafChanges> integrate_rays(const Frame& frame);
+
   TsdfConfig config_;
   FusedGrid fused_;
   StageTimes times_;
+  // Per-frame scratch, kept to spare the allocations: the range-limited depth image, and the
+  // leaves a frame updates (one voxel per leaf, at leaf origin / 8; all off between frames).
+  std::vector<float> depth_buffer_;
+  openvdb::MaskTree blocks_;
 };
 
 }  // namespace sonomap

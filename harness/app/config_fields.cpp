@@ -52,7 +52,7 @@ FieldTable vdb_gpdf_fields(VdbGpdfConfig& c) {
 
 FieldTable tsdf_fields(TsdfConfig& c) {
   Field voxel = number("voxel", &c.voxel, "m", kMinVoxel, kMaxVoxel, "voxel size (`--voxel`)");
-  Field carving = flag("space_carving", &c.space_carving, "trace each ray from the sensor");
+  Field carving = flag("space_carving", &c.space_carving, "carve the observed free space in view");
   carving.aliases = {"carving"};
   return {
       voxel,
