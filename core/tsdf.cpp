@@ -86,9 +86,9 @@ bool has_depth_image(const Frame& frame) {
 
 // Marks in `blocks` (one voxel per leaf, at leaf origin / 8) every leaf that may hold a voxel
 // in the band of a return: within the truncation of the return along its ray and within
-// `slack` to the side. Per image row, the half extents of that segment's box bound every pixel's
-// of the row, so neighbouring returns mostly give the same box of leaves; a return inside the
-// region where the previous return's box would not change is skipped.
+// `slack` to the side. Per image row one set of half extents bounds that segment's box for
+// every pixel of the row, so neighbouring returns mostly give the same box of leaves; a return
+// inside the region where the previous return's box would not change is skipped.
 void mark_band_leaves(const DepthImage& image, const Eigen::Isometry3d& world_T_camera, double leaf_size,
                       double truncation, double slack, openvdb::MaskTree& blocks) {
   openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(blocks);
@@ -101,10 +101,10 @@ void mark_band_leaves(const DepthImage& image, const Eigen::Isometry3d& world_T_
     // Rays (x, y, 1) in the optical frame, in the world: a unit ray's component along world
     // axis a is at most |ray_a| / |ray|, where |ray_a| is largest at one end of the row and
     // |ray| is smallest at the column of the principal point.
-    const double y = (v - k.cy) / k.fy;
-    const Eigen::Vector3d first = r * Eigen::Vector3d(-k.cx / k.fx, y, 1.0);
+    const double row_y = (v - k.cy) / k.fy;
+    const Eigen::Vector3d first = r * Eigen::Vector3d(-k.cx / k.fx, row_y, 1.0);
     const Eigen::Vector3d last = first + (image.width() - 1) * r.col(0) / k.fx;
-    const Eigen::Vector3d unit = (first.cwiseAbs().cwiseMax(last.cwiseAbs()) / std::sqrt(1.0 + y * y))
+    const Eigen::Vector3d unit = (first.cwiseAbs().cwiseMax(last.cwiseAbs()) / std::sqrt(1.0 + row_y * row_y))
                                      .cwiseMin(1.0);
     const Eigen::Vector3f m = (truncation * unit.array() + slack).matrix().cast<float>();
     const Eigen::Vector3f row = first.cast<float>();
