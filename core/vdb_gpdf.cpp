@@ -248,42 +248,15 @@ void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskG
                                      openvdb::tools::IGNORE_TILES);
 }
 
-// Rays converge on the sensor, so near it thousands of them cross the same voxel: each crossed
-// voxel is queried once, at its centre, and fused with one unit of weight per ray that crossed
-// it (what one carving point per ray and voxel would give, at a fraction of the GP queries:
-// measured 5x fewer on the room). Near the surface only centres the depth image saw free.
-std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
-                                         const std::vector<std::vector<openvdb::Coord>>& carved,
-                                         const LocalGps& locals, const openvdb::MaskGrid& near,
-                                         const DepthView& view) {
-  openvdb::Int32Grid counts(0);
-  {
-    auto acc = counts.getAccessor();
-    for (const auto& leaf_voxels : carved)
-      for (const auto& v : leaf_voxels) acc.setValue(v, acc.getValue(v) + 1);
-  }
-  std::vector<std::pair<openvdb::Coord, int>> voxels;
-  voxels.reserve(counts.activeVoxelCount());
-  for (auto v = counts.cbeginValueOn(); v; ++v) voxels.emplace_back(v.getCoord(), *v);
-  std::vector<QueryUpdate> out(voxels.size());
-  std::vector<char> valid(voxels.size(), 0);
-  const double vg = config.global_voxel;
-  parallel_for_each_index(voxels.size(), [&](size_t i) {
-    const Eigen::Vector3d q = voxel_centre(voxels[i].first, vg);
-    if (near.tree().isValueOn(voxels[i].first) && !view.seen_in_front(q)) return;
-    const GpPrediction pred = locals.smallest(q, config.inverse_variance_fusion);
-    if (!pred.valid) return;
-    const double rays = voxels[i].second;
-    const double weight = config.inverse_variance_fusion ? rays / pred.variance : rays;
-    out[i] = {voxels[i].first, static_cast<float>(-pred.distance), static_cast<float>(weight)};
-    valid[i] = 1;
-  });
-  size_t kept = 0;
-  for (size_t i = 0; i < out.size(); ++i)
-    if (valid[i]) out[kept++] = out[i];
-  out.resize(kept);
-  return out;
-}
+// What one query point or carving ray says of the global voxel it falls in. The value itself
+// is the local GPs' distance at the voxel's centre, computed once per voxel whatever the
+// number of votes (one GP query per touched voxel: a frame's 66k query points and carving
+// rays fall in 22k voxels at 5 cm, in 4k at 10 cm); a vote gives its sign and one unit of
+// weight. "Hit" votes come from a surface point or a point behind it, "free" votes from
+// points in front of the surface and from carving rays.
+enum Vote { kHitInside, kHitFree, kFrontInside, kFree, kVoteKinds };
+using VoteCounts = openvdb::math::Vec4<int32_t>;
+using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
 
 // The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
 // GP training points and (after train_local_gps) its GP, and the global voxels near the
@@ -358,73 +331,43 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
                           [&](size_t i) { local.gps.gps[i].train(local.training[i], params); });
 }
 
-// One local leaf's query points and their signed distances (negative in free space, positive
-// behind) from the nearest local GP, and the observed global voxels its rays cross. A query
-// point's value is moved to the centre of the voxel it falls in by first order (value +
-// signed gradient . (centre - q)): the marching cubes read values at voxel centres, and
-// binning the raw values would shift the surface by up to half a voxel (measured: 0.8 voxel
-// worst case on a sphere).
+// One local leaf's votes: per source point p, p itself, points behind it (along the normal)
+// and in front of it (along the ray), and every observed global voxel its ray crosses. A
+// vote's sign is the side of p's tangent plane its voxel's centre lies on: the marching cubes
+// read values at voxel centres, and a point's own side can differ from its centre's by up to
+// half a voxel (binning raw values shifted a sphere's surface by 0.8 voxel).
 class LeafQueries {
  public:
-  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DepthView& view,
-              const DistanceWeightGrid& fused, size_t leaf, const Eigen::Vector3d& origin)
-      : config_(config), local_(local), view_(view), leaf_(leaf), origin_(origin), vg_(config.global_voxel),
-        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()),
-        near_acc_(local.near.getConstAccessor()) {}
+  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
+              const Eigen::Vector3d& origin)
+      : config_(config), origin_(origin), vg_(config.global_voxel), observed_(fused.getConstAccessor()),
+        local_acc_(local.points.getConstAccessor()) {}
 
-  std::vector<QueryUpdate> updates;
-  std::vector<openvdb::Coord> carved;
+  std::vector<std::pair<openvdb::Coord, Vote>> votes;
 
-  // A training point p of this leaf: p itself, points behind it and in front of it, its ray.
   void add(const Eigen::Vector3d& p) {
     Eigen::Vector3d u = origin_ - p;
     const double range = u.norm();
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
-    {
-      // p is a centroid inside this leaf, so this leaf's GP is its nearest: no lookup.
-      const GpPrediction pred = local_.gps.gps[leaf_].predict(p, config_.inverse_variance_fusion);
-      const double d = pred.valid ? pred.distance : 0.0;
-      fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
-           pred.valid ? pred.variance : config_.variance_on_surface, Source::surface);
-    }
+    const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
+    vote(p, p, facing, true);
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
     // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
     if (normal.dot(u) > kMinNormalDotRay)
-      for (int j = 1; j <= config_.trunc_behind; ++j) fuse_query(p - j * config_.query_step * normal, 1.0);
+      for (int j = 1; j <= config_.trunc_behind; ++j) vote(p - j * config_.query_step * normal, p, facing, true);
     // Front points along the ray: the ray crossed that space, so it is free for sure.
-    for (int j = 1; j <= config_.trunc_front; ++j) fuse_query(p + j * config_.query_step * u, -1.0);
+    for (int j = 1; j <= config_.trunc_front; ++j) vote(p + j * config_.query_step * u, p, facing, false);
     if (config_.free_space_carving) carve(p, u, range);
   }
 
  private:
-  enum class Source { surface, behind, front };
-
-  // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
-  void fuse(const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
-            double variance, Source source) {
+  void vote(const Eigen::Vector3d& q, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, bool hit) {
     const openvdb::Coord v = voxel_of(q, vg_);
-    const Eigen::Vector3d centre = voxel_centre(v, vg_);
-    const double at_centre = value + toward_inside.dot(centre - q);
-    // Near the surface a free-space value needs the depth image's word for it. A surface
-    // point's value moved along a normal that an edge tilts can call free a centre the camera
-    // saw behind the surface, and a front point beside a grazing face a centre inside it.
-    if (source == Source::surface && at_centre < 0.0 && view_.seen_behind(centre, kBehindMargin * vg_)) return;
-    if (source == Source::front && near_acc_.isValueOn(v) && !view_.seen_in_front(centre)) return;
-    const bool hit = source != Source::front;
-    const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
-    updates.push_back({v, static_cast<float>(at_centre), weight, hit});
-  }
-
-  // sign: +1 behind the surface, -1 in front of it.
-  void fuse_query(const Eigen::Vector3d& q, double sign) {
-    // The source point's own leaf among the candidates: the leaf nearest by centre can hold a
-    // patch far from q's foot point (measured on a sphere: front/carve value RMSE 2.0 -> 1.1 cm).
-    const GpPrediction pred = local_.gps.smallest(q, config_.inverse_variance_fusion, static_cast<int>(leaf_));
-    if (!pred.valid) return;  // f <= 0: no distance, skipped
-    fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0 ? Source::behind : Source::front);
+    const bool inside = facing.dot(voxel_centre(v, vg_) - p) <= 0.0;
+    votes.emplace_back(v, hit ? (inside ? kHitInside : kHitFree) : (inside ? kFrontInside : kFree));
   }
 
   // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
@@ -450,72 +393,99 @@ class LeafQueries {
         const openvdb::Coord v = dda.voxel();
         // A voxel on the block's edge may round into the neighbour: that block visits it.
         if (leaf_origin_of(v) != block || !(observed_.getValue(v)[1] > 0.0f)) continue;
-        carved.push_back(v);
+        votes.emplace_back(v, kFree);
       } while (dda.step());
     } while (blocks.step());
   }
 
   const VdbGpdfConfig& config_;
-  const LocalFrame& local_;
-  const DepthView& view_;
-  size_t leaf_;
   Eigen::Vector3d origin_;
   double vg_;
   DistanceWeightGrid::ConstAccessor observed_;
   PointSumGrid::ConstAccessor local_acc_;
-  openvdb::MaskGrid::ConstAccessor near_acc_;
 };
 
-// Stage "query_points": every local leaf's query updates, then the carving updates last.
-std::vector<std::vector<QueryUpdate>> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
-                                                    const DepthView& view,
-                                                    const DistanceWeightGrid& fused,
-                                                    const Eigen::Vector3d& origin) {
-  const size_t leaves = local.training.size();
-  std::vector<std::vector<QueryUpdate>> updates(leaves);
-  std::vector<std::vector<openvdb::Coord>> carved(leaves);  // voxels each leaf's rays cross
+// Counts the frame's votes per global voxel. Integer counts: the sum is the same in any order.
+void count_votes(const std::vector<std::vector<std::pair<openvdb::Coord, Vote>>>& votes, VoteGrid& counts) {
+  auto acc = counts.getAccessor();
+  for (const auto& leaf_votes : votes)
+    for (const auto& [voxel, vote] : leaf_votes) {
+      VoteCounts c = acc.getValue(voxel);
+      ++c[vote];
+      acc.setValue(voxel, c);
+    }
+}
+
+// One voxel's update from its votes and the local GPs' distance d at its centre: each kept
+// vote adds +-d with one unit of weight. Near the surface a free-space value needs the depth
+// image's word for it (DepthView): a centre the camera saw behind the surface keeps no
+// negative "hit" vote (a surface point's plane, tilted by an edge, can call it free), and a
+// free vote near the surface needs the centre's pixel and its 8 neighbours to have measured
+// something farther (a front point or ray beside a grazing face passes a centre inside it).
+bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
+                  const LocalGps& locals, const openvdb::MaskGrid::ConstAccessor& near,
+                  const DepthView& view, QueryUpdate& out) {
+  const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
+  if (votes[kHitFree] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) votes[kHitFree] = 0;
+  if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
+  const int inside = votes[kHitInside] + votes[kFrontInside];
+  const int free = votes[kHitFree] + votes[kFree];
+  if (inside + free == 0) return false;
+  const GpPrediction pred = locals.smallest(c, config.inverse_variance_fusion);
+  if (!pred.valid) return false;
+  const double weight = config.inverse_variance_fusion ? (inside + free) / pred.variance : inside + free;
+  out = {voxel, static_cast<float>(pred.distance * (inside - free) / (inside + free)), static_cast<float>(weight),
+         votes[kHitInside] + votes[kHitFree] > 0};
+  return true;
+}
+
+// Stage "query_points": every local leaf's votes, counted per global voxel, then one GP query
+// per voxel (in parallel, each voxel writing its own slot).
+std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
+                                       const DepthView& view, const DistanceWeightGrid& fused,
+                                       const Eigen::Vector3d& origin) {
+  const size_t leaves = local.sources.size();
+  std::vector<std::vector<std::pair<openvdb::Coord, Vote>>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, view, fused, leaf, origin);
+    LeafQueries queries(config, local, fused, origin);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
-    updates[leaf] = std::move(queries.updates);
-    carved[leaf] = std::move(queries.carved);
+    votes[leaf] = std::move(queries.votes);
   });
-  updates.push_back(carving_updates(config, carved, local.gps, local.near, view));
+  VoteGrid counts(VoteCounts(0));
+  count_votes(votes, counts);
+  std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
+  counts.tree().getNodes(vote_leaves);
+  std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
+  parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
+    const auto near = local.near.getConstAccessor();
+    QueryUpdate update;
+    for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v)
+      if (voxel_update(config, v.getCoord(), *v, local.gps, near, view, update)) per_leaf[i].push_back(update);
+  });
+  std::vector<QueryUpdate> updates;
+  for (const auto& leaf_updates : per_leaf) updates.insert(updates.end(), leaf_updates.begin(), leaf_updates.end());
   return updates;
 }
 
-// Stage "fusion": sums the frame's updates per voxel (in a fixed order) into `frame_sums`, then
-// blends each touched voxel once by the fusion rule. Without a cap this equals one
-// running-average update per query point.
-void fuse_updates(const VdbGpdfConfig& config, const std::vector<std::vector<QueryUpdate>>& updates,
+// Stage "fusion": writes the frame's updates (one per voxel) into `frame_sums` as (sum of
+// w d, sum of w), then blends each touched voxel once by the fusion rule.
+void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& updates,
                   FusedGrid& fused, DistanceWeightGrid& frame_sums) {
-  openvdb::MaskGrid hits(false);
-  {
-    auto acc = frame_sums.getAccessor();
-    auto hit_acc = hits.getAccessor();
-    for (const auto& leaf_updates : updates)
-      for (const auto& u : leaf_updates) {
-
-        const openvdb::Vec2s v = acc.getValue(u.voxel);
-        acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
-        if (u.hit) hit_acc.setValueOn(u.voxel);
-      }
-  }
+  auto sums = frame_sums.getAccessor();
   auto acc = fused.grid().getAccessor();
-  auto hit_acc = hits.getConstAccessor();
   const float vacated_below = static_cast<float>(-kVacatedVoxels * config.global_voxel);
-  for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
-    for (auto v = leaf->cbeginValueOn(); v; ++v) {
-      const openvdb::Vec2s sum = *v;
-      const openvdb::Vec2s old = acc.getValue(v.getCoord());
-      // Space the map knew as behind a surface that this frame sees only as free, by more
-      // than a voxel on average (so not the inside of a thin wall seen from its other side):
-      // the object has left, and this frame's value replaces the old one at once instead of
-      // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
-      // voxels only the floor's front queries reach, took 20 frames to clear).
-      const bool vacated = old[0] > 0.0f && !hit_acc.isValueOn(v.getCoord()) && sum[0] < vacated_below * sum[1];
-      acc.setValue(v.getCoord(), fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
-    }
+  for (const QueryUpdate& u : updates) {
+    const openvdb::Vec2s sum(u.weight * u.distance, u.weight);
+    sums.setValue(u.voxel, sum);
+    const openvdb::Vec2s old = acc.getValue(u.voxel);
+    // Space the map knew as behind a surface that this frame sees only as free, by more
+    // than a voxel on average (so not the inside of a thin wall seen from its other side):
+    // the object has left, and this frame's value replaces the old one at once instead of
+    // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
+    // voxels only the floor's front queries reach, took 20 frames to clear).
+    const bool vacated = old[0] > 0.0f && !u.hit && sum[0] < vacated_below * sum[1];
+    acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
+  }
 }
 
 // Runs one stage and records its wall time under `name`.
@@ -597,7 +567,7 @@ void VdbGpdf::integrate(const Frame& frame) {
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
   LocalFrame local;
   const DepthView view(frame);
-  std::vector<std::vector<QueryUpdate>> updates;
+  std::vector<QueryUpdate> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
   timed(times_, "voxelise", [&] { voxelise(config_, points, local); });
   timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
