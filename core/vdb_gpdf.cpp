@@ -297,14 +297,44 @@ void add_sparse_sources(double global_voxel, LocalFrame& local) {
 
 // Stage "voxelise". Training points are the centroids of the frame's points per local voxel,
 // not the voxel centres: centres put a face up to half a local voxel inside or outside it.
-void voxelise(const VdbGpdfConfig& config, const std::vector<Eigen::Vector3d>& points, LocalFrame& out) {
-  {
-    auto acc = out.points.getAccessor();
-    for (const auto& p : points) {
-      const openvdb::Coord c = voxel_of(p, config.local_voxel);
-      acc.setValue(c, acc.getValue(c) + openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f));
+// Floor of x for |x| < 2^31 without a libm call (positions are bounded to 10 km).
+inline int floor_int(double x) {
+  const int i = static_cast<int>(x);
+  return x < i ? i - 1 : i;
+}
+
+// Adds the frame's points in range to their local voxels. Neighbouring pixels mostly share a
+// voxel, so a run of points in one voxel is summed first and added to the grid once.
+void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& grid) {
+  auto acc = grid.getAccessor();
+  const double inverse = 1.0 / config.local_voxel;
+  const double min2 = config.min_range * config.min_range, max2 = config.max_range * config.max_range;
+  const Eigen::Matrix3d rotation = frame.world_T_camera.linear();
+  const Eigen::Vector3d translation = frame.world_T_camera.translation();
+  openvdb::Coord run(std::numeric_limits<int>::min());
+  openvdb::Vec4f run_sum(0.0f);
+  auto flush = [&] {
+    if (run_sum[3] > 0.0f) acc.setValue(run, acc.getValue(run) + run_sum);
+  };
+  for (const Eigen::Vector3f& pc : frame.points_camera) {
+    if (!pc.allFinite()) continue;
+    const Eigen::Vector3d c = pc.cast<double>();
+    const double r2 = c.squaredNorm();
+    if (r2 < min2 || r2 > max2) continue;
+    const Eigen::Vector3d p = rotation * c + translation;
+    const openvdb::Coord v(floor_int(p.x() * inverse), floor_int(p.y() * inverse), floor_int(p.z() * inverse));
+    if (v != run) {
+      flush();
+      run = v;
+      run_sum = openvdb::Vec4f(0.0f);
     }
+    run_sum += openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f);
   }
+  flush();
+}
+
+void voxelise(const VdbGpdfConfig& config, const Frame& frame, LocalFrame& out) {
+  sum_points(config, frame, out.points);
   out.gps.voxel = config.local_voxel;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) {
     std::vector<Eigen::Vector3f> pts;
@@ -563,13 +593,12 @@ void VdbGpdf::integrate(const Frame& frame) {
   check_pose(frame);
   times_.stages.clear();
   const auto t_start = Clock::now();
-  const std::vector<Eigen::Vector3d> points = world_points(frame, config_.min_range, config_.max_range);
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
   LocalFrame local;
   const DepthView view(frame);
   std::vector<QueryUpdate> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
-  timed(times_, "voxelise", [&] { voxelise(config_, points, local); });
+  timed(times_, "voxelise", [&] { voxelise(config_, frame, local); });
   timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
   timed(times_, "query_points", [&] { updates = query_updates(config_, local, view, fused_.grid(), origin); });
   timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });
