@@ -71,7 +71,8 @@ void Rasteriser::add(const Eigen::Vector3f& point) {
   RasterCell& cell = circle_.bins[static_cast<size_t>(bin)];
   if (range_f < cell.range) cell = RasterCell{range_f, point};
 
-  int row = static_cast<int>(std::floor((height - config_.band_min) / config_.row_height));
+  // floor() of a non-negative quotient (the height is in the band): truncation, no libm call.
+  int row = static_cast<int>((height - config_.band_min) / config_.row_height);
   // The top edge of the last row is inside it (the band is closed); rounding of the
   // division must not push it out.
   if (row == cylinder_.rows && height <= config_.row_top(cylinder_.rows - 1) + 1e-9) {
