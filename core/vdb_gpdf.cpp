@@ -26,6 +26,11 @@ constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
 // A surface point's negative value is dropped at a centre the camera saw more than this many
 // voxels behind the measured surface (see LeafQueries::fuse).
 constexpr double kBehindMargin = 0.25;
+// An "inside" vote is dropped at a centre whose pixel measured a surface more than this many
+// voxels beyond it: a tangent plane extended past a silhouette edge calls the free space
+// beside the edge inside, and the object grows sideways (smoke, frame 0: four bins read a box
+// 13-18 cm nearer than the wall behind its edge).
+constexpr double kThroughMargin = 0.5;
 // A global voxel without a training point gets a query source of its own only when its
 // frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
 // a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
@@ -92,6 +97,16 @@ class DepthView {
     if (!usable_ || !pixel_of(world, u, v, z)) return false;
     const float d = depth_at(u, v);
     return d > 0.0f && d < z - margin;
+  }
+
+  // In the image, and its own pixel measured a surface more than `margin` farther: the camera
+  // saw through the point.
+  bool seen_through(const Eigen::Vector3d& world, double margin) const {
+    int u = 0, v = 0;
+    double z = 0.0;
+    if (!usable_ || !pixel_of(world, u, v, z)) return false;
+    const float d = depth_at(u, v);
+    return d > 0.0f && d > z + margin;
   }
 
  private:
@@ -254,9 +269,19 @@ void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskG
 // rays fall in 22k voxels at 5 cm, in 4k at 10 cm); a vote gives its sign and one unit of
 // weight. "Hit" votes come from a surface point or a point behind it, "free" votes from
 // points in front of the surface and from carving rays.
-enum Vote { kHitInside, kHitFree, kFrontInside, kFree, kVoteKinds };
-using VoteCounts = openvdb::math::Vec4<int32_t>;
+// A source point's own vote is different: its voxel's value is the centre's signed offset from
+// the tangent plane (what a surface sample says of a voxel it lies in), not the GPs' distance,
+// which beyond a silhouette edge would push the surface sideways into free space.
+enum VoteKind { kHitInside, kHitFree, kFrontInside, kFree, kSurface };
+struct Vote {
+  openvdb::Coord voxel;
+  VoteKind kind;
+  float offset = 0.0f;  // kSurface: signed distance of the centre from the tangent plane
+};
+using VoteCounts = openvdb::math::Vec4<int32_t>;  // per kind, kHitInside .. kFree
 using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
+// Surface votes: (sum of positive offsets, their count, sum of negative offsets, their count).
+using SurfaceVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
 
 // The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
 // GP training points and (after train_local_gps) its GP, and the global voxels near the
@@ -373,7 +398,7 @@ class LeafQueries {
       : config_(config), origin_(origin), vg_(config.global_voxel), observed_(fused.getConstAccessor()),
         local_acc_(local.points.getConstAccessor()) {}
 
-  std::vector<std::pair<openvdb::Coord, Vote>> votes;
+  std::vector<Vote> votes;
 
   void add(const Eigen::Vector3d& p) {
     Eigen::Vector3d u = origin_ - p;
@@ -382,7 +407,8 @@ class LeafQueries {
     u /= range;  // toward the sensor: the direction the query points are placed along
     const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
-    vote(p, p, facing, true);
+    const openvdb::Coord own = voxel_of(p, vg_);
+    votes.push_back({own, kSurface, static_cast<float>(-facing.dot(voxel_centre(own, vg_) - p))});
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
     // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
@@ -397,7 +423,7 @@ class LeafQueries {
   void vote(const Eigen::Vector3d& q, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, bool hit) {
     const openvdb::Coord v = voxel_of(q, vg_);
     const bool inside = facing.dot(voxel_centre(v, vg_) - p) <= 0.0;
-    votes.emplace_back(v, hit ? (inside ? kHitInside : kHitFree) : (inside ? kFrontInside : kFree));
+    votes.push_back({v, hit ? (inside ? kHitInside : kHitFree) : (inside ? kFrontInside : kFree)});
   }
 
   // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
@@ -423,7 +449,7 @@ class LeafQueries {
         const openvdb::Coord v = dda.voxel();
         // A voxel on the block's edge may round into the neighbour: that block visits it.
         if (leaf_origin_of(v) != block || !(observed_.getValue(v)[1] > 0.0f)) continue;
-        votes.emplace_back(v, kFree);
+        votes.push_back({v, kFree});
       } while (dda.step());
     } while (blocks.step());
   }
@@ -435,14 +461,25 @@ class LeafQueries {
   PointSumGrid::ConstAccessor local_acc_;
 };
 
-// Counts the frame's votes per global voxel. Integer counts: the sum is the same in any order.
-void count_votes(const std::vector<std::vector<std::pair<openvdb::Coord, Vote>>>& votes, VoteGrid& counts) {
+// Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
+// order: the result does not depend on the thread count.
+void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface) {
   auto acc = counts.getAccessor();
+  auto surface_acc = surface.getAccessor();
   for (const auto& leaf_votes : votes)
-    for (const auto& [voxel, vote] : leaf_votes) {
-      VoteCounts c = acc.getValue(voxel);
-      ++c[vote];
-      acc.setValue(voxel, c);
+    for (const Vote& vote : leaf_votes) {
+      if (vote.kind == kSurface) {
+        openvdb::Vec4f sums = surface_acc.getValue(vote.voxel);
+        const int at = vote.offset > 0.0f ? 0 : 2;
+        sums[at] += vote.offset;
+        sums[at + 1] += 1.0f;
+        surface_acc.setValue(vote.voxel, sums);
+        acc.setValueOn(vote.voxel);  // every voted voxel is visited through `counts`
+        continue;
+      }
+      VoteCounts c = acc.getValue(vote.voxel);
+      ++c[vote.kind];
+      acc.setValue(vote.voxel, c);
     }
 }
 
@@ -453,19 +490,29 @@ void count_votes(const std::vector<std::vector<std::pair<openvdb::Coord, Vote>>>
 // free vote near the surface needs the centre's pixel and its 8 neighbours to have measured
 // something farther (a front point or ray beside a grazing face passes a centre inside it).
 bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
-                  const LocalGps& locals, const openvdb::MaskGrid::ConstAccessor& near,
-                  const DepthView& view, QueryUpdate& out) {
+                  openvdb::Vec4f surface, const LocalGps& locals,
+                  const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
   const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
-  if (votes[kHitFree] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) votes[kHitFree] = 0;
+  if (votes[kHitFree] + surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) {
+    votes[kHitFree] = 0;
+    surface[2] = surface[3] = 0.0f;
+  }
   if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
+  if (votes[kFrontInside] > 0 && view.seen_in_front(c)) votes[kFrontInside] = 0;
   const int inside = votes[kHitInside] + votes[kFrontInside];
   const int free = votes[kHitFree] + votes[kFree];
-  if (inside + free == 0) return false;
-  const GpPrediction pred = locals.smallest(c, config.inverse_variance_fusion);
+  const double surface_votes = surface[1] + surface[3];
+  const double weight = inside + free + surface_votes;
+  if (weight == 0.0) return false;
+  GpPrediction pred;
+  pred.valid = true;
+  pred.variance = config.variance_on_surface;
+  if (inside + free > 0 || config.inverse_variance_fusion) pred = locals.smallest(c, config.inverse_variance_fusion);
   if (!pred.valid) return false;
-  const double weight = config.inverse_variance_fusion ? (inside + free) / pred.variance : inside + free;
-  out = {voxel, static_cast<float>(pred.distance * (inside - free) / (inside + free)), static_cast<float>(weight),
-         votes[kHitInside] + votes[kHitFree] > 0};
+  const double sum = surface[0] + surface[2] + pred.distance * (inside - free);
+  out = {voxel, static_cast<float>(sum / weight),
+         static_cast<float>(config.inverse_variance_fusion ? weight / pred.variance : weight),
+         votes[kHitInside] + votes[kHitFree] + surface_votes > 0};
   return true;
 }
 
@@ -475,22 +522,25 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
                                        const DepthView& view, const DistanceWeightGrid& fused,
                                        const Eigen::Vector3d& origin) {
   const size_t leaves = local.sources.size();
-  std::vector<std::vector<std::pair<openvdb::Coord, Vote>>> votes(leaves);
+  std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
     LeafQueries queries(config, local, fused, origin);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
     votes[leaf] = std::move(queries.votes);
   });
   VoteGrid counts(VoteCounts(0));
-  count_votes(votes, counts);
+  SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
+  count_votes(votes, counts, surface);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
   counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
   parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
     const auto near = local.near.getConstAccessor();
+    const auto surface_acc = surface.getConstAccessor();
     QueryUpdate update;
     for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v)
-      if (voxel_update(config, v.getCoord(), *v, local.gps, near, view, update)) per_leaf[i].push_back(update);
+      if (voxel_update(config, v.getCoord(), *v, surface_acc.getValue(v.getCoord()), local.gps, near, view, update))
+        per_leaf[i].push_back(update);
   });
   std::vector<QueryUpdate> updates;
   for (const auto& leaf_updates : per_leaf) updates.insert(updates.end(), leaf_updates.begin(), leaf_updates.end());
