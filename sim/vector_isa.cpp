@@ -33,6 +33,18 @@ bool supported(VectorIsa isa) {
 
 VectorIsa vector_isa() { return current().load(std::memory_order_relaxed); }
 
+const char* name_of(VectorIsa isa) {
+  switch (isa) {
+    case VectorIsa::Avx2:
+      return "AVX2";
+    case VectorIsa::Avx512:
+      return "AVX-512";
+    case VectorIsa::Baseline:
+      break;
+  }
+  return "baseline";
+}
+
 ScopedVectorIsa::ScopedVectorIsa(VectorIsa isa) : previous_(vector_isa()) {
   if (!supported(isa)) throw std::invalid_argument("ScopedVectorIsa: this CPU lacks the instruction set asked for");
   current().store(isa);

@@ -19,6 +19,9 @@ bool supported(VectorIsa isa);
 // The instruction set in use: the best supported one, unless a ScopedVectorIsa limits it.
 VectorIsa vector_isa();
 
+// "baseline", "AVX2" or "AVX-512" (for reports).
+const char* name_of(VectorIsa isa);
+
 // Limits the sensor's loops to `isa` (which must be supported) while it lives, process-wide:
 // tests use it to run the baseline and the AVX2 paths on the same frame.
 class ScopedVectorIsa {
