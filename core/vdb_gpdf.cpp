@@ -26,11 +26,6 @@ constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
 // A surface point's negative value is dropped at a centre the camera saw more than this many
 // voxels behind the measured surface (see LeafQueries::fuse).
 constexpr double kBehindMargin = 0.25;
-// An "inside" vote is dropped at a centre whose pixel measured a surface more than this many
-// voxels beyond it: a tangent plane extended past a silhouette edge calls the free space
-// beside the edge inside, and the object grows sideways (smoke, frame 0: four bins read a box
-// 13-18 cm nearer than the wall behind its edge).
-constexpr double kThroughMargin = 0.5;
 // A global voxel without a training point gets a query source of its own only when its
 // frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
 // a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
@@ -97,16 +92,6 @@ class DepthView {
     if (!usable_ || !pixel_of(world, u, v, z)) return false;
     const float d = depth_at(u, v);
     return d > 0.0f && d < z - margin;
-  }
-
-  // In the image, and its own pixel measured a surface more than `margin` farther: the camera
-  // saw through the point.
-  bool seen_through(const Eigen::Vector3d& world, double margin) const {
-    int u = 0, v = 0;
-    double z = 0.0;
-    if (!usable_ || !pixel_of(world, u, v, z)) return false;
-    const float d = depth_at(u, v);
-    return d > 0.0f && d > z + margin;
   }
 
  private:
@@ -272,13 +257,13 @@ void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskG
 // A source point's own vote is different: its voxel's value is the centre's signed offset from
 // the tangent plane (what a surface sample says of a voxel it lies in), not the GPs' distance,
 // which beyond a silhouette edge would push the surface sideways into free space.
-enum VoteKind { kHitInside, kHitFree, kFrontInside, kFree, kSurface };
+enum VoteKind { kHitInside, kFrontInside, kFree, kSurface };
 struct Vote {
   openvdb::Coord voxel;
   VoteKind kind;
   float offset = 0.0f;  // kSurface: signed distance of the centre from the tangent plane
 };
-using VoteCounts = openvdb::math::Vec4<int32_t>;  // per kind, kHitInside .. kFree
+using VoteCounts = openvdb::math::Vec3<int32_t>;  // per kind, kHitInside .. kFree
 using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
 // Surface votes: (sum of positive offsets, their count, sum of negative offsets, their count).
 using SurfaceVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
@@ -394,9 +379,9 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
 class LeafQueries {
  public:
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
-              const Eigen::Vector3d& origin)
-      : config_(config), origin_(origin), vg_(config.global_voxel), observed_(fused.getConstAccessor()),
-        local_acc_(local.points.getConstAccessor()) {}
+              size_t leaf, const Eigen::Vector3d& origin)
+      : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
+        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()) {}
 
   std::vector<Vote> votes;
 
@@ -408,7 +393,11 @@ class LeafQueries {
     const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
-    votes.push_back({own, kSurface, static_cast<float>(-facing.dot(voxel_centre(own, vg_) - p))});
+    // The GP's own distance at p (its surface fit misses p by that much) moves the value
+    // inward, as the first-order value at the centre: -d(p) - facing . (centre - p).
+    const GpPrediction at_p = gp_.predict(p, false);  // p lies in this leaf: its GP is the nearest
+    const double d = at_p.valid ? at_p.distance : 0.0;
+    votes.push_back({own, kSurface, static_cast<float>(-d - facing.dot(voxel_centre(own, vg_) - p))});
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
     // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
@@ -422,8 +411,20 @@ class LeafQueries {
  private:
   void vote(const Eigen::Vector3d& q, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, bool hit) {
     const openvdb::Coord v = voxel_of(q, vg_);
-    const bool inside = facing.dot(voxel_centre(v, vg_) - p) <= 0.0;
-    votes.push_back({v, hit ? (inside ? kHitInside : kHitFree) : (inside ? kFrontInside : kFree)});
+    // A point behind whose centre lies in front of the plane sits astride the surface: the
+    // plane's offset is its value (the GPs' distance, to the nearest surface anywhere, would
+    // push the surface out). A point in front whose centre lies behind the plane is judged by
+    // the depth image at the centre (voxel_update).
+    const double offset = -facing.dot(voxel_centre(v, vg_) - p);  // > 0 behind the plane
+    if (hit && offset <= 0.0) {
+      votes.push_back({v, kSurface, static_cast<float>(offset)});
+      return;
+    }
+    if (!hit && offset > 0.0) {
+      votes.push_back({v, kFrontInside});
+      return;
+    }
+    votes.push_back({v, hit ? kHitInside : kFree});
   }
 
   // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
@@ -455,6 +456,7 @@ class LeafQueries {
   }
 
   const VdbGpdfConfig& config_;
+  const SurfaceGp& gp_;
   Eigen::Vector3d origin_;
   double vg_;
   DistanceWeightGrid::ConstAccessor observed_;
@@ -493,14 +495,21 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
                   openvdb::Vec4f surface, const LocalGps& locals,
                   const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
   const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
-  if (votes[kHitFree] + surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) {
-    votes[kHitFree] = 0;
-    surface[2] = surface[3] = 0.0f;
-  }
+  if (surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) surface[2] = surface[3] = 0.0f;
   if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
-  if (votes[kFrontInside] > 0 && view.seen_in_front(c)) votes[kFrontInside] = 0;
+  // A front point's centre behind the tangent plane: free if the camera saw through it, inside
+  // if its pixel saw the surface nearer, else unknown (beside a silhouette, where a curved or
+  // grazing surface's plane is no guide: a column's edge grew 8 cm into free space).
+  if (votes[kFrontInside] > 0) {
+    if (view.seen_in_front(c)) {
+      votes[kFree] += votes[kFrontInside];
+      votes[kFrontInside] = 0;
+    } else if (!view.seen_behind(c, kBehindMargin * config.global_voxel)) {
+      votes[kFrontInside] = 0;
+    }
+  }
   const int inside = votes[kHitInside] + votes[kFrontInside];
-  const int free = votes[kHitFree] + votes[kFree];
+  const int free = votes[kFree];
   const double surface_votes = surface[1] + surface[3];
   const double weight = inside + free + surface_votes;
   if (weight == 0.0) return false;
@@ -512,7 +521,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   const double sum = surface[0] + surface[2] + pred.distance * (inside - free);
   out = {voxel, static_cast<float>(sum / weight),
          static_cast<float>(config.inverse_variance_fusion ? weight / pred.variance : weight),
-         votes[kHitInside] + votes[kHitFree] + surface_votes > 0};
+         votes[kHitInside] + surface_votes > 0};
   return true;
 }
 
@@ -524,7 +533,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   const size_t leaves = local.sources.size();
   std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, fused, origin);
+    LeafQueries queries(config, local, fused, leaf, origin);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
     votes[leaf] = std::move(queries.votes);
   });
