@@ -91,34 +91,32 @@ void MovedGhosts::place(Tracked& object, const Eigen::Isometry3d& pose) {
       }
 }
 
-// A vacated cell is seen empty when the camera looks through some part of it: its centre or
-// one of its corners projects into the depth image and the reading at that pixel lies beyond
-// it (z-depth) by more than the tolerance. (The centre alone is not enough: the part of a cell
-// that a ghost point lies in may be in view while the centre is just outside the image.)
-bool MovedGhosts::seen_through(const Eigen::Vector3d& centre, const Frame& depth,
+// The camera looks through world point p when p projects into the depth image and the reading
+// at that pixel lies beyond p (z-depth) by more than the tolerance. A pixel without a return
+// does not count.
+bool MovedGhosts::seen_through(const Eigen::Vector3d& world_point, const Frame& depth,
                                const Eigen::Isometry3d& camera_T_world) const {
   const PinholeIntrinsics& k = depth.intrinsics;
-  for (int i = -1; i < 8; ++i) {
-    const Eigen::Vector3d corner(i & 1 ? 0.5 : -0.5, i & 2 ? 0.5 : -0.5, i & 4 ? 0.5 : -0.5);
-    const Eigen::Vector3d p = camera_T_world * (i < 0 ? centre : Eigen::Vector3d(centre + cell_ * corner));
-    if (!(p.z() > 0.0)) continue;
-    const long u = std::lround(k.fx * p.x() / p.z() + k.cx), v = std::lround(k.fy * p.y() / p.z() + k.cy);
-    if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) continue;
-    const double reading = depth.depth[static_cast<std::size_t>(v) * depth.width + u];
-    if (reading > 0.0 && reading > p.z() + config_.tolerance) return true;
-  }
-  return false;
+  if (!k.valid()) return false;
+  const Eigen::Vector3d p = camera_T_world * world_point;
+  if (!(p.z() > 0.0)) return false;
+  const long u = std::lround(k.fx * p.x() / p.z() + k.cx), v = std::lround(k.fy * p.y() / p.z() + k.cy);
+  if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) return false;
+  const double reading = depth.depth[static_cast<std::size_t>(v) * depth.width + u];
+  return reading > 0.0 && reading > p.z() + config_.tolerance;
 }
 
+void MovedGhosts::mark_seen(Tracked& object, Cell& cell, int frame) {
+  cell.seen_empty_at = frame;
+  if (!object.result.seen_empty_frame) object.result.seen_empty_frame = frame;
+}
+
+// Vacated cells whose centres the camera looks through are seen empty from this frame.
 void MovedGhosts::look_through(Tracked& object, const Frame& depth, const Eigen::Isometry3d& camera_T_world,
                                int frame) {
-  if (!depth.intrinsics.valid() || depth.width <= 0 || depth.height <= 0) return;
-  for (Cell& cell : object.cells) {
-    if (cell.occupied_at == frame || cell.seen_empty_at >= 0) continue;
-    if (!seen_through(cell.centre, depth, camera_T_world)) continue;
-    cell.seen_empty_at = frame;
-    if (!object.result.seen_empty_frame) object.result.seen_empty_frame = frame;
-  }
+  for (Cell& cell : object.cells)
+    if (cell.occupied_at != frame && cell.seen_empty_at < 0 && seen_through(cell.centre, depth, camera_T_world))
+      mark_seen(object, cell, frame);
 }
 
 MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optional<Eigen::Isometry3d>>& poses,
@@ -155,9 +153,12 @@ MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optiona
       Tracked& object = objects_[m];
       const auto it = object.index.find(key);
       if (it == object.index.end()) continue;
-      const Cell& cell = object.cells[it->second];
+      Cell& cell = object.cells[it->second];
       if (cell.occupied_at == frame) continue;  // the object's place now: not a ghost of it
       read_any = true;
+      // The camera looking through the ghost point itself shows the cell empty too (its centre
+      // may lie just outside the image while the ghost is inside).
+      if (cell.seen_empty_at < 0 && seen_through(q, depth, camera_T_world)) mark_seen(object, cell, frame);
       if (cell.seen_empty_at < 0) {
         ++out.objects[m].unseen;
         continue;

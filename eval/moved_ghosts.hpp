@@ -3,8 +3,8 @@
 // ghosts"). A run feeds every evaluated frame in order: the true poses of the moving objects,
 // the estimated circle and its truth, and the depth image with the TRUE camera pose. Per
 // object the tracker keeps the places it occupied (cells of a grid), notes when the camera
-// first sees through each vacated cell, and counts the ghost bins whose estimate point lies in
-// a vacated cell. Pure: no I/O.
+// first sees through each vacated cell (its centre, or a ghost point read in it), and counts
+// the ghost bins whose estimate point lies in a vacated cell. Pure: no I/O.
 #pragma once
 
 #include "core/raster.hpp"
@@ -110,7 +110,9 @@ class MovedGhosts {
   void place(Tracked& object, const Eigen::Isometry3d& pose);
   void look_through(Tracked& object, const Frame& depth, const Eigen::Isometry3d& camera_T_world,
                     int frame);
-  bool seen_through(const Eigen::Vector3d& centre, const Frame& depth, const Eigen::Isometry3d& camera_T_world) const;
+  bool seen_through(const Eigen::Vector3d& world_point, const Frame& depth,
+                    const Eigen::Isometry3d& camera_T_world) const;
+  void mark_seen(Tracked& object, Cell& cell, int frame);
   std::uint64_t key_of(const Eigen::Vector3d& p) const;
 
   MovedGhostsConfig config_;

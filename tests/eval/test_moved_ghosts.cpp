@@ -241,3 +241,28 @@ TEST_CASE("Moved ghosts: bad input is refused", "[moved_ghosts]") {
   tracker.add_frame(5, {std::nullopt}, Circle(360), Circle(360), depth, cam);
   CHECK_THROWS_AS(tracker.add_frame(5, {std::nullopt}, Circle(360), Circle(360), depth, cam), std::invalid_argument);
 }
+
+TEST_CASE("Moved ghosts: a ghost at the image's edge is seen empty when the camera looks through "
+          "the ghost itself, though its cell's centre is out of view",
+          "[moved_ghosts]") {
+  eval::MovedGhosts tracker({{"box", kBoxLocal}}, {});
+  tracker.add_frame(0, {translation(kBoxAt)}, truth_circle(true), truth_circle(true),
+                    depth_image(kBoxAt, camera()), camera());
+  // The box has gone and the camera has turned 33.6 degrees left: the image's right edge
+  // (38.7 degrees off its axis) now passes between two ghost points the map still holds on the
+  // box's old front face. Inside: (1.31, -0.11, 1) at 38.4 degrees (pixel column 63.2 of 64),
+  // while the centre of its 5 cm cell, (1.325, -0.125, 1.025), is at 39.0 degrees (column
+  // 63.9: out). Outside: (1.31, -0.16, 1) at 40.6 degrees.
+  const Eigen::Isometry3d turned = camera(33.6);
+  Circle map = truth_circle(false), truth = truth_circle(false);
+  const Eigen::Vector3f inside(1.31f, -0.11f, 1.0f), outside(1.31f, -0.16f, 1.0f);
+  for (const auto& [bin, point] : {std::pair{355, inside}, std::pair{353, outside}}) {
+    map.bins[bin].point = point;
+    map.bins[bin].range = point.head<2>().norm();
+  }
+  const auto out = tracker.add_frame(1, {std::nullopt}, map, truth, depth_image(std::nullopt, turned), turned);
+  CHECK(out.bins == 2);
+  CHECK(out.objects[0].seen == 1);
+  CHECK(out.objects[0].unseen == 1);
+  CHECK(out.seen_bins == 1);
+}
