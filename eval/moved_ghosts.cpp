@@ -44,13 +44,17 @@ MovedGhosts::MovedGhosts(std::vector<MovingObjectShape> objects, const MovedGhos
   }
 }
 
-std::uint64_t MovedGhosts::key_of(const Eigen::Vector3d& p) const {
+// The grid key of cell (x, y, z): 21 bits per axis (positions within 10 km fit at 2 cm).
+static std::uint64_t key_of_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
   std::uint64_t key = 0;
-  for (int a = 0; a < 3; ++a) {
-    const auto i = static_cast<std::int64_t>(std::floor(p[a] / cell_)) + kKeyOffset;
-    key = (key << 21) | (static_cast<std::uint64_t>(std::clamp<std::int64_t>(i, 0, 2 * kKeyOffset - 1)));
-  }
+  for (const std::int64_t i : {x, y, z})
+    key = (key << 21) | static_cast<std::uint64_t>(std::clamp<std::int64_t>(i + kKeyOffset, 0, 2 * kKeyOffset - 1));
   return key;
+}
+
+std::uint64_t MovedGhosts::key_of(const Eigen::Vector3d& p) const {
+  const auto cell = [&](double v) { return static_cast<std::int64_t>(std::floor(v / cell_)); };
+  return key_of_cell(cell(p.x()), cell(p.y()), cell(p.z()));
 }
 
 // Marks the cells whose centres lie in the object's box at `pose` grown by the tolerance (and
@@ -85,7 +89,7 @@ void MovedGhosts::place(Tracked& object, const Eigen::Isometry3d& pose) {
       for (int z = lo.z(); z <= hi.z(); ++z) {
         const Eigen::Vector3d centre = (Eigen::Vector3d(x, y, z).array() + 0.5) * cell_;
         if (centre.z() < z_lo || centre.z() > z_hi || !local.contains(object_T_world * centre)) continue;
-        const auto [it, added] = object.index.try_emplace(key_of(centre), static_cast<int>(object.cells.size()));
+        const auto [it, added] = object.index.try_emplace(key_of_cell(x, y, z), static_cast<int>(object.cells.size()));
         if (added) object.cells.push_back({centre});
         object.held.push_back(it->second);
       }
