@@ -123,11 +123,10 @@ void MovedGhosts::look_through(Tracked& object, const Frame& depth, const Eigen:
       mark_seen(object, cell, frame);
 }
 
-MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optional<Eigen::Isometry3d>>& poses,
-                                       const Circle& estimate, const Circle& truth, const Frame& depth,
-                                       const Eigen::Isometry3d& world_T_camera) {
-  if (poses.size() != objects_.size())
-    throw std::invalid_argument("moved ghosts: " + std::to_string(poses.size()) + " poses for " +
+void MovedGhosts::check_input(int frame, std::size_t poses, const Circle& estimate, const Circle& truth,
+                              const Frame& depth) const {
+  if (poses != objects_.size())
+    throw std::invalid_argument("moved ghosts: " + std::to_string(poses) + " poses for " +
                                 std::to_string(objects_.size()) + " objects");
   if (estimate.size() != truth.size())
     throw std::invalid_argument("moved ghosts: estimate and truth circles differ in size");
@@ -136,6 +135,40 @@ MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optiona
   if (frame <= last_frame_)
     throw std::invalid_argument("moved ghosts: frame " + std::to_string(frame) + " after frame " +
                                 std::to_string(last_frame_));
+}
+
+// Which objects' vacated cells the ghost bin's estimate point q lies in; notes the seen ones'
+// ages (frames since seen empty) for the clearing figure.
+void MovedGhosts::read_bin(const Eigen::Vector3d& q, int frame, const Frame& depth,
+                           const Eigen::Isometry3d& camera_T_world, MovedGhostFrame& out) {
+  const std::uint64_t key = key_of(q);
+  bool read_any = false, seen_any = false;
+  for (std::size_t m = 0; m < objects_.size(); ++m) {
+    Tracked& object = objects_[m];
+    const auto it = object.index.find(key);
+    if (it == object.index.end()) continue;
+    Cell& cell = object.cells[it->second];
+    if (cell.occupied_at == frame) continue;  // the object's place now: not a ghost of it
+    read_any = true;
+    // The camera looking through the ghost point itself shows the cell empty too (its centre
+    // may lie just outside the image while the ghost is inside).
+    if (cell.seen_empty_at < 0 && seen_through(q, depth, camera_T_world)) mark_seen(object, cell, frame);
+    if (cell.seen_empty_at < 0) {
+      ++out.objects[m].unseen;
+      continue;
+    }
+    ++out.objects[m].seen;
+    seen_any = true;
+    object.worst_age = std::max(object.worst_age, frame - cell.seen_empty_at);
+  }
+  out.bins += read_any;
+  out.seen_bins += seen_any;
+}
+
+MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optional<Eigen::Isometry3d>>& poses,
+                                       const Circle& estimate, const Circle& truth, const Frame& depth,
+                                       const Eigen::Isometry3d& world_T_camera) {
+  check_input(frame, poses.size(), estimate, truth, depth);
   const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
   for (std::size_t m = 0; m < objects_.size(); ++m) {
     Tracked& object = objects_[m];
@@ -148,31 +181,9 @@ MovedGhostFrame MovedGhosts::add_frame(int frame, const std::vector<std::optiona
   MovedGhostFrame out;
   out.objects.resize(objects_.size());
   for (int b = 0; b < estimate.size(); ++b) {
-    if (!is_ghost(estimate.bins[b], truth.bins[b], config_.tolerance)) continue;
     const Eigen::Vector3d q = estimate.bins[b].point.cast<double>();
-    if (!q.allFinite()) continue;
-    const std::uint64_t key = key_of(q);
-    bool read_any = false, seen_any = false;
-    for (std::size_t m = 0; m < objects_.size(); ++m) {
-      Tracked& object = objects_[m];
-      const auto it = object.index.find(key);
-      if (it == object.index.end()) continue;
-      Cell& cell = object.cells[it->second];
-      if (cell.occupied_at == frame) continue;  // the object's place now: not a ghost of it
-      read_any = true;
-      // The camera looking through the ghost point itself shows the cell empty too (its centre
-      // may lie just outside the image while the ghost is inside).
-      if (cell.seen_empty_at < 0 && seen_through(q, depth, camera_T_world)) mark_seen(object, cell, frame);
-      if (cell.seen_empty_at < 0) {
-        ++out.objects[m].unseen;
-        continue;
-      }
-      ++out.objects[m].seen;
-      seen_any = true;
-      object.worst_age = std::max(object.worst_age, frame - cell.seen_empty_at);
-    }
-    out.bins += read_any;
-    out.seen_bins += seen_any;
+    if (is_ghost(estimate.bins[b], truth.bins[b], config_.tolerance) && q.allFinite())
+      read_bin(q, frame, depth, camera_T_world, out);
   }
   for (std::size_t m = 0; m < objects_.size(); ++m) {
     MovedObjectClearing& r = objects_[m].result;

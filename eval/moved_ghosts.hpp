@@ -106,6 +106,10 @@ class MovedGhosts {
     int worst_age = -1;  // this frame: max (frame - seen_empty_at) over read cells; -1: none
     int open_worst = 0;  // max over earlier frames of (next frame - frame + worst age there)
   };
+  void check_input(int frame, std::size_t poses, const Circle& estimate, const Circle& truth,
+                   const Frame& depth) const;
+  void read_bin(const Eigen::Vector3d& q, int frame, const Frame& depth, const Eigen::Isometry3d& camera_T_world,
+                MovedGhostFrame& out);
   void occupy(Tracked& object, const Eigen::Isometry3d& pose, int frame);
   void place(Tracked& object, const Eigen::Isometry3d& pose);
   void look_through(Tracked& object, const Frame& depth, const Eigen::Isometry3d& camera_T_world,
