@@ -8,6 +8,7 @@
 // too far or not at all (misses: what a wearer walks into). VDB-GPDF must not miss more than
 // the TSDF peer in any class in view. The table is printed (WARN) for docs/fidelity.md:
 //   build/tests/test_harness "[fidelity]"
+#include "core/open3d_tsdf.hpp"
 #include "core/rasteriser.hpp"
 #include "core/tsdf.hpp"
 #include "core/vdb_gpdf.hpp"
@@ -195,7 +196,8 @@ using MapperMaker = std::function<std::unique_ptr<Mapper>()>;
 const std::vector<std::pair<std::string, MapperMaker>>& mappers() {
   static const std::vector<std::pair<std::string, MapperMaker>> list = {
       {"vdb_gpdf", [] { return std::make_unique<VdbGpdf>(); }},
-      {"tsdf", [] { return std::make_unique<Tsdf>(); }}};
+      {"tsdf", [] { return std::make_unique<Tsdf>(); }},
+      {"open3d", [] { return std::make_unique<Open3dTsdf>(); }}};
   return list;
 }
 
@@ -257,8 +259,9 @@ std::string percent(int part, int whole) {
 }
 
 // Runs the seeded rooms, prints the per-class table (docs/fidelity.md) and checks that
-// VDB-GPDF reads no more bins too far than the TSDF peer in each of `classes`.
-void check_classes(std::initializer_list<int> classes) {
+// VDB-GPDF reads no more bins too far than the TSDF peer in each of `against_tsdf`, and than
+// Open3D's ScalableTSDFVolume in each of `against_open3d`.
+void check_classes(std::initializer_list<int> against_tsdf, std::initializer_list<int> against_open3d) {
   std::vector<Tally> tallies(mappers().size());
   for (uint64_t seed = 1; seed <= kRooms; ++seed) run_room(seed, tallies);
   std::ostringstream table;
@@ -274,18 +277,30 @@ void check_classes(std::initializer_list<int> classes) {
     table << '\n';
   }
   WARN(table.str());
-  for (int k : classes) {
-    INFO(kClassNames[k] << ": too far vdb_gpdf " << tallies[0].far[k] << ", tsdf " << tallies[1].far[k]
-                        << " of " << tallies[0].bins[k]);
-    CHECK(tallies[0].bins[k] > 0);
-    CHECK(tallies[0].far[k] <= tallies[1].far[k]);
-  }
+  const std::array<std::pair<size_t, std::initializer_list<int>>, 2> peers{
+      {{1, against_tsdf}, {2, against_open3d}}};
+  for (const auto& [peer, classes] : peers)
+    for (int k : classes) {
+      INFO(kClassNames[k] << ": too far vdb_gpdf " << tallies[0].far[k] << ", "
+                          << mappers()[peer].first << ' ' << tallies[peer].far[k] << " of "
+                          << tallies[0].bins[k]);
+      CHECK(tallies[0].bins[k] > 0);
+      CHECK(tallies[0].far[k] <= tallies[peer].far[k]);
+    }
 }
 
 }  // namespace
 
 TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
-          "peer at corners, low boxes, thin slabs, grazing faces and where a box left",
+          "peer at corners, low boxes, thin slabs, grazing faces and where a box left, nor "
+          "than Open3D's TSDF except at grazing faces",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated});
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kCorner, kLow, kThin, kVacated});
+}
+
+// The open part (issue "VDB-GPDF right"): Open3D misses 1 grazing bin, VDB-GPDF 2 (docs/fidelity.md).
+// Hidden from CTest until it passes; run it with `test_harness "[fidelity-open]"`.
+TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more grazing bins too far than Open3D's TSDF",
+          "[.][fidelity-open]") {
+  check_classes({}, {kGrazing});
 }
