@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "core/parallel.hpp"
+#include "core/pixel.hpp"
 #include "core/stopwatch.hpp"
 
 namespace sonomap {
@@ -74,38 +75,28 @@ class DepthView {
   // In the image, and every measured depth of its pixel and the 8 around it is farther.
   bool seen_in_front(const Eigen::Vector3d& world) const {
     if (!usable_) return true;
-    int u = 0, v = 0;
-    double z = 0.0;
-    if (!pixel_of(world, u, v, z)) return false;
-    for (int y = std::max(v - 1, 0); y <= std::min(v + 1, frame_.height - 1); ++y)
-      for (int x = std::max(u - 1, 0); x <= std::min(u + 1, frame_.width - 1); ++x) {
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
+    if (!px) return false;
+    for (int y = std::max(px->v - 1, 0); y <= std::min(px->v + 1, frame_.height - 1); ++y)
+      for (int x = std::max(px->u - 1, 0); x <= std::min(px->u + 1, frame_.width - 1); ++x) {
         const float d = depth_at(x, y);
-        if (d > 0.0f && d <= z) return false;
+        if (d > 0.0f && d <= c.z()) return false;
       }
     return true;
   }
 
   // In the image, and its own pixel measured a surface more than `margin` nearer.
   bool seen_behind(const Eigen::Vector3d& world, double margin) const {
-    int u = 0, v = 0;
-    double z = 0.0;
-    if (!usable_ || !pixel_of(world, u, v, z)) return false;
-    const float d = depth_at(u, v);
-    return d > 0.0f && d < z - margin;
+    if (!usable_) return false;
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
+    if (!px) return false;
+    const float d = depth_at(px->u, px->v);
+    return d > 0.0f && d < c.z() - margin;
   }
 
  private:
-  bool pixel_of(const Eigen::Vector3d& world, int& u, int& v, double& z) const {
-    const Eigen::Vector3d c = camera_T_world_ * world;
-    if (!(c.z() > 0.0)) return false;
-    const PinholeIntrinsics& k = frame_.intrinsics;
-    const double pu = std::round(k.fx * c.x() / c.z() + k.cx), pv = std::round(k.fy * c.y() / c.z() + k.cy);
-    if (!(pu >= 0.0 && pv >= 0.0 && pu < frame_.width && pv < frame_.height)) return false;
-    u = static_cast<int>(pu);
-    v = static_cast<int>(pv);
-    z = c.z();
-    return true;
-  }
   float depth_at(int u, int v) const { return frame_.depth[static_cast<size_t>(v) * frame_.width + u]; }
 
   const Frame& frame_;
@@ -513,14 +504,18 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   const double surface_votes = surface[1] + surface[3];
   const double weight = inside + free + surface_votes;
   if (weight == 0.0) return false;
-  GpPrediction pred;
-  pred.valid = true;
-  pred.variance = config.variance_on_surface;
-  if (inside + free > 0 || config.inverse_variance_fusion) pred = locals.smallest(c, config.inverse_variance_fusion);
-  if (!pred.valid) return false;
-  const double sum = surface[0] + surface[2] + pred.distance * (inside - free);
+  // Surface votes carry their own values: the GPs are asked only for the other votes' distance
+  // (or for the variance that inverse-variance fusion weights by).
+  double distance = 0.0, variance = config.variance_on_surface;
+  if (inside + free > 0 || config.inverse_variance_fusion) {
+    const GpPrediction pred = locals.smallest(c, config.inverse_variance_fusion);
+    if (!pred.valid) return false;
+    distance = pred.distance;
+    variance = pred.variance;
+  }
+  const double sum = surface[0] + surface[2] + distance * (inside - free);
   out = {voxel, static_cast<float>(sum / weight),
-         static_cast<float>(config.inverse_variance_fusion ? weight / pred.variance : weight),
+         static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
          votes[kHitInside] + surface_votes > 0};
   return true;
 }

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "eval/moved_ghosts.hpp"
 
+#include "core/pixel.hpp"
+#include "eval/metrics.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -10,14 +13,6 @@ namespace {
 
 constexpr double kMinCell = 0.02;  // m: a tolerance of 0 still gets a grid of finite size
 constexpr std::int64_t kKeyOffset = std::int64_t{1} << 20;  // 2^21 cells per axis, centred
-
-// A ghost bin as eval/metrics.cpp counts it: known, and the truth empty or farther than the
-// estimate by more than the tolerance.
-bool is_ghost(const RasterCell& estimate, const RasterCell& truth, double tolerance) {
-  if (!estimate.known()) return false;
-  if (!truth.known()) return true;
-  return static_cast<double>(truth.range) - static_cast<double>(estimate.range) > tolerance;
-}
 
 }  // namespace
 
@@ -100,13 +95,11 @@ void MovedGhosts::place(Tracked& object, const Eigen::Isometry3d& pose) {
 // does not count.
 bool MovedGhosts::seen_through(const Eigen::Vector3d& world_point, const Frame& depth,
                                const Eigen::Isometry3d& camera_T_world) const {
-  const PinholeIntrinsics& k = depth.intrinsics;
-  if (!k.valid()) return false;
+  if (!depth.intrinsics.valid()) return false;
   const Eigen::Vector3d p = camera_T_world * world_point;
-  if (!(p.z() > 0.0)) return false;
-  const long u = std::lround(k.fx * p.x() / p.z() + k.cx), v = std::lround(k.fy * p.y() / p.z() + k.cy);
-  if (u < 0 || v < 0 || u >= depth.width || v >= depth.height) return false;
-  const double reading = depth.depth[static_cast<std::size_t>(v) * depth.width + u];
+  const std::optional<Pixel> px = pixel_of(depth.intrinsics, depth.width, depth.height, p);
+  if (!px) return false;
+  const double reading = depth.depth[static_cast<std::size_t>(px->v) * depth.width + px->u];
   return reading > 0.0 && reading > p.z() + config_.tolerance;
 }
 
