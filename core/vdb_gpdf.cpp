@@ -30,8 +30,11 @@ constexpr double kBehindMargin = 0.25;
 // A global voxel without a training point gets a query source of its own only when its
 // frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
 // a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
-// along its diagonal, tests/core/test_circle_fidelity.cpp).
+// along its diagonal, tests/core/test_circle_fidelity.cpp). At the image's edge the frame
+// cuts every patch, and one local voxel is enough: a panel entering the view at the image's
+// corner, 16 pixels in three global voxels, was otherwise not in the circle.
 constexpr int kMinSparseCells = 3;
+constexpr double kEdgePixels = 3.0;
 // A voxel the map holds as behind a surface that this frame sees only as free, by more than
 // this many voxels on average, has been vacated: an object left.
 constexpr double kVacatedVoxels = 1.0;
@@ -84,6 +87,17 @@ class DepthView {
         if (d > 0.0f && d <= c.z()) return false;
       }
     return true;
+  }
+
+  // Projects less than `pixels` inside the image's edge (or outside the image).
+  bool at_edge(const Eigen::Vector3d& world, double pixels) const {
+    if (!usable_) return false;
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    if (!(c.z() > 0.0)) return false;
+    const PinholeIntrinsics& k = frame_.intrinsics;
+    const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
+    const double inset = std::min(std::min(u + 0.5, frame_.width - 0.5 - u), std::min(v + 0.5, frame_.height - 0.5 - v));
+    return inset < pixels;
   }
 
   // In the image, and its own pixel measured a surface more than `margin` nearer.
@@ -274,7 +288,7 @@ struct LocalFrame {
   openvdb::MaskGrid near{false};
 };
 
-void add_sparse_sources(double global_voxel, LocalFrame& local) {
+void add_sparse_sources(double global_voxel, const DepthView& view, LocalFrame& local) {
   // Per global voxel: how many local voxels hold points; -1 once it has a source.
   openvdb::Int32Grid counts(0);
   auto count = counts.getAccessor();
@@ -290,7 +304,8 @@ void add_sparse_sources(double global_voxel, LocalFrame& local) {
     for (auto v = leaf->cbeginValueOn(); v; ++v) {
       const Eigen::Vector3d c = centroid(*v);
       const openvdb::Coord g = voxel_of(c, global_voxel);
-      if (count.getValue(g) < kMinSparseCells) continue;
+      const int cells = count.getValue(g);
+      if (cells < 1 || (cells < kMinSparseCells && !view.at_edge(c, kEdgePixels))) continue;
       count.setValue(g, -1);
       local.sources[leaf_index].push_back(c.cast<float>());
     }
@@ -334,7 +349,7 @@ void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& g
   flush();
 }
 
-void voxelise(const VdbGpdfConfig& config, const Frame& frame, LocalFrame& out) {
+void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
   out.gps.voxel = config.local_voxel;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) {
@@ -352,7 +367,7 @@ void voxelise(const VdbGpdfConfig& config, const Frame& frame, LocalFrame& out) 
   }
   out.gps.link_neighbours();
   near_surface(out.points, config.global_voxel, out.near);
-  add_sparse_sources(config.global_voxel, out);
+  add_sparse_sources(config.global_voxel, view, out);
 }
 
 // Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
@@ -652,7 +667,7 @@ void VdbGpdf::integrate(const Frame& frame) {
   const DepthView view(frame);
   std::vector<QueryUpdate> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
-  timed(times_, "voxelise", [&] { voxelise(config_, frame, local); });
+  timed(times_, "voxelise", [&] { voxelise(config_, frame, view, local); });
   timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
   timed(times_, "query_points", [&] { updates = query_updates(config_, local, view, fused_.grid(), origin); });
   timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });
