@@ -42,6 +42,10 @@ class Rasteriser {
   const RasterOrigin& origin() const { return origin_; }
 
  private:
+  // The bin of body-frame direction (x ahead, y left), as floor(atan2(y, x) / bin width) with
+  // the edge snapping described at add().
+  int bin_of(double x, double y) const;
+
   RasterConfig config_;
   RasterOrigin origin_;
   double cos_heading_ = 1.0;

@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "core/parallel.hpp"
+#include "core/pixel.hpp"
 #include "core/stopwatch.hpp"
 
 namespace sonomap {
@@ -29,8 +30,11 @@ constexpr double kBehindMargin = 0.25;
 // A global voxel without a training point gets a query source of its own only when its
 // frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
 // a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
-// along its diagonal, tests/core/test_circle_fidelity.cpp).
+// along its diagonal, tests/core/test_circle_fidelity.cpp). At the image's edge the frame
+// cuts every patch, and one local voxel is enough: a panel entering the view at the image's
+// corner, 16 pixels in three global voxels, was otherwise not in the circle.
 constexpr int kMinSparseCells = 3;
+constexpr double kEdgePixels = 3.0;
 // A voxel the map holds as behind a surface that this frame sees only as free, by more than
 // this many voxels on average, has been vacated: an object left.
 constexpr double kVacatedVoxels = 1.0;
@@ -74,38 +78,39 @@ class DepthView {
   // In the image, and every measured depth of its pixel and the 8 around it is farther.
   bool seen_in_front(const Eigen::Vector3d& world) const {
     if (!usable_) return true;
-    int u = 0, v = 0;
-    double z = 0.0;
-    if (!pixel_of(world, u, v, z)) return false;
-    for (int y = std::max(v - 1, 0); y <= std::min(v + 1, frame_.height - 1); ++y)
-      for (int x = std::max(u - 1, 0); x <= std::min(u + 1, frame_.width - 1); ++x) {
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
+    if (!px) return false;
+    for (int y = std::max(px->v - 1, 0); y <= std::min(px->v + 1, frame_.height - 1); ++y)
+      for (int x = std::max(px->u - 1, 0); x <= std::min(px->u + 1, frame_.width - 1); ++x) {
         const float d = depth_at(x, y);
-        if (d > 0.0f && d <= z) return false;
+        if (d > 0.0f && d <= c.z()) return false;
       }
     return true;
   }
 
-  // In the image, and its own pixel measured a surface more than `margin` nearer.
-  bool seen_behind(const Eigen::Vector3d& world, double margin) const {
-    int u = 0, v = 0;
-    double z = 0.0;
-    if (!usable_ || !pixel_of(world, u, v, z)) return false;
-    const float d = depth_at(u, v);
-    return d > 0.0f && d < z - margin;
-  }
-
- private:
-  bool pixel_of(const Eigen::Vector3d& world, int& u, int& v, double& z) const {
+  // Projects less than `pixels` inside the image's edge (or outside the image).
+  bool at_edge(const Eigen::Vector3d& world, double pixels) const {
+    if (!usable_) return false;
     const Eigen::Vector3d c = camera_T_world_ * world;
     if (!(c.z() > 0.0)) return false;
     const PinholeIntrinsics& k = frame_.intrinsics;
-    const double pu = std::round(k.fx * c.x() / c.z() + k.cx), pv = std::round(k.fy * c.y() / c.z() + k.cy);
-    if (!(pu >= 0.0 && pv >= 0.0 && pu < frame_.width && pv < frame_.height)) return false;
-    u = static_cast<int>(pu);
-    v = static_cast<int>(pv);
-    z = c.z();
-    return true;
+    const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
+    const double inset = std::min(std::min(u + 0.5, frame_.width - 0.5 - u), std::min(v + 0.5, frame_.height - 0.5 - v));
+    return inset < pixels;
   }
+
+  // In the image, and its own pixel measured a surface more than `margin` nearer.
+  bool seen_behind(const Eigen::Vector3d& world, double margin) const {
+    if (!usable_) return false;
+    const Eigen::Vector3d c = camera_T_world_ * world;
+    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
+    if (!px) return false;
+    const float d = depth_at(px->u, px->v);
+    return d > 0.0f && d < c.z() - margin;
+  }
+
+ private:
   float depth_at(int u, int v) const { return frame_.depth[static_cast<size_t>(v) * frame_.width + u]; }
 
   const Frame& frame_;
@@ -248,42 +253,25 @@ void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskG
                                      openvdb::tools::IGNORE_TILES);
 }
 
-// Rays converge on the sensor, so near it thousands of them cross the same voxel: each crossed
-// voxel is queried once, at its centre, and fused with one unit of weight per ray that crossed
-// it (what one carving point per ray and voxel would give, at a fraction of the GP queries:
-// measured 5x fewer on the room). Near the surface only centres the depth image saw free.
-std::vector<QueryUpdate> carving_updates(const VdbGpdfConfig& config,
-                                         const std::vector<std::vector<openvdb::Coord>>& carved,
-                                         const LocalGps& locals, const openvdb::MaskGrid& near,
-                                         const DepthView& view) {
-  openvdb::Int32Grid counts(0);
-  {
-    auto acc = counts.getAccessor();
-    for (const auto& leaf_voxels : carved)
-      for (const auto& v : leaf_voxels) acc.setValue(v, acc.getValue(v) + 1);
-  }
-  std::vector<std::pair<openvdb::Coord, int>> voxels;
-  voxels.reserve(counts.activeVoxelCount());
-  for (auto v = counts.cbeginValueOn(); v; ++v) voxels.emplace_back(v.getCoord(), *v);
-  std::vector<QueryUpdate> out(voxels.size());
-  std::vector<char> valid(voxels.size(), 0);
-  const double vg = config.global_voxel;
-  parallel_for_each_index(voxels.size(), [&](size_t i) {
-    const Eigen::Vector3d q = voxel_centre(voxels[i].first, vg);
-    if (near.tree().isValueOn(voxels[i].first) && !view.seen_in_front(q)) return;
-    const GpPrediction pred = locals.smallest(q, config.inverse_variance_fusion);
-    if (!pred.valid) return;
-    const double rays = voxels[i].second;
-    const double weight = config.inverse_variance_fusion ? rays / pred.variance : rays;
-    out[i] = {voxels[i].first, static_cast<float>(-pred.distance), static_cast<float>(weight)};
-    valid[i] = 1;
-  });
-  size_t kept = 0;
-  for (size_t i = 0; i < out.size(); ++i)
-    if (valid[i]) out[kept++] = out[i];
-  out.resize(kept);
-  return out;
-}
+// What one query point or carving ray says of the global voxel it falls in. The value itself
+// is the local GPs' distance at the voxel's centre, computed once per voxel whatever the
+// number of votes (one GP query per touched voxel: a frame's 66k query points and carving
+// rays fall in 22k voxels at 5 cm, in 4k at 10 cm); a vote gives its sign and one unit of
+// weight. "Hit" votes come from a surface point or a point behind it, "free" votes from
+// points in front of the surface and from carving rays.
+// A source point's own vote is different: its voxel's value is the centre's signed offset from
+// the tangent plane (what a surface sample says of a voxel it lies in), not the GPs' distance,
+// which beyond a silhouette edge would push the surface sideways into free space.
+enum VoteKind { kHitInside, kFrontInside, kFree, kSurface };
+struct Vote {
+  openvdb::Coord voxel;
+  VoteKind kind;
+  float offset = 0.0f;  // kSurface: signed distance of the centre from the tangent plane
+};
+using VoteCounts = openvdb::math::Vec3<int32_t>;  // per kind, kHitInside .. kFree
+using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
+// Surface votes: (sum of positive offsets, their count, sum of negative offsets, their count).
+using SurfaceVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
 
 // The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
 // GP training points and (after train_local_gps) its GP, and the global voxels near the
@@ -300,7 +288,7 @@ struct LocalFrame {
   openvdb::MaskGrid near{false};
 };
 
-void add_sparse_sources(double global_voxel, LocalFrame& local) {
+void add_sparse_sources(double global_voxel, const DepthView& view, LocalFrame& local) {
   // Per global voxel: how many local voxels hold points; -1 once it has a source.
   openvdb::Int32Grid counts(0);
   auto count = counts.getAccessor();
@@ -316,7 +304,8 @@ void add_sparse_sources(double global_voxel, LocalFrame& local) {
     for (auto v = leaf->cbeginValueOn(); v; ++v) {
       const Eigen::Vector3d c = centroid(*v);
       const openvdb::Coord g = voxel_of(c, global_voxel);
-      if (count.getValue(g) < kMinSparseCells) continue;
+      const int cells = count.getValue(g);
+      if (cells < 1 || (cells < kMinSparseCells && !view.at_edge(c, kEdgePixels))) continue;
       count.setValue(g, -1);
       local.sources[leaf_index].push_back(c.cast<float>());
     }
@@ -324,14 +313,44 @@ void add_sparse_sources(double global_voxel, LocalFrame& local) {
 
 // Stage "voxelise". Training points are the centroids of the frame's points per local voxel,
 // not the voxel centres: centres put a face up to half a local voxel inside or outside it.
-void voxelise(const VdbGpdfConfig& config, const std::vector<Eigen::Vector3d>& points, LocalFrame& out) {
-  {
-    auto acc = out.points.getAccessor();
-    for (const auto& p : points) {
-      const openvdb::Coord c = voxel_of(p, config.local_voxel);
-      acc.setValue(c, acc.getValue(c) + openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f));
+// Floor of x for |x| < 2^31 without a libm call (positions are bounded to 10 km).
+inline int floor_int(double x) {
+  const int i = static_cast<int>(x);
+  return x < i ? i - 1 : i;
+}
+
+// Adds the frame's points in range to their local voxels. Neighbouring pixels mostly share a
+// voxel, so a run of points in one voxel is summed first and added to the grid once.
+void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& grid) {
+  auto acc = grid.getAccessor();
+  const double inverse = 1.0 / config.local_voxel;
+  const double min2 = config.min_range * config.min_range, max2 = config.max_range * config.max_range;
+  const Eigen::Matrix3d rotation = frame.world_T_camera.linear();
+  const Eigen::Vector3d translation = frame.world_T_camera.translation();
+  openvdb::Coord run(std::numeric_limits<int>::min());
+  openvdb::Vec4f run_sum(0.0f);
+  auto flush = [&] {
+    if (run_sum[3] > 0.0f) acc.setValue(run, acc.getValue(run) + run_sum);
+  };
+  for (const Eigen::Vector3f& pc : frame.points_camera) {
+    if (!pc.allFinite()) continue;
+    const Eigen::Vector3d c = pc.cast<double>();
+    const double r2 = c.squaredNorm();
+    if (r2 < min2 || r2 > max2) continue;
+    const Eigen::Vector3d p = rotation * c + translation;
+    const openvdb::Coord v(floor_int(p.x() * inverse), floor_int(p.y() * inverse), floor_int(p.z() * inverse));
+    if (v != run) {
+      flush();
+      run = v;
+      run_sum = openvdb::Vec4f(0.0f);
     }
+    run_sum += openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f);
   }
+  flush();
+}
+
+void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
+  sum_points(config, frame, out.points);
   out.gps.voxel = config.local_voxel;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) {
     std::vector<Eigen::Vector3f> pts;
@@ -348,7 +367,7 @@ void voxelise(const VdbGpdfConfig& config, const std::vector<Eigen::Vector3d>& p
   }
   out.gps.link_neighbours();
   near_surface(out.points, config.global_voxel, out.near);
-  add_sparse_sources(config.global_voxel, out);
+  add_sparse_sources(config.global_voxel, view, out);
 }
 
 // Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
@@ -358,73 +377,60 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
                           [&](size_t i) { local.gps.gps[i].train(local.training[i], params); });
 }
 
-// One local leaf's query points and their signed distances (negative in free space, positive
-// behind) from the nearest local GP, and the observed global voxels its rays cross. A query
-// point's value is moved to the centre of the voxel it falls in by first order (value +
-// signed gradient . (centre - q)): the marching cubes read values at voxel centres, and
-// binning the raw values would shift the surface by up to half a voxel (measured: 0.8 voxel
-// worst case on a sphere).
+// One local leaf's votes: per source point p, p itself, points behind it (along the normal)
+// and in front of it (along the ray), and every observed global voxel its ray crosses. A
+// vote's sign is the side of p's tangent plane its voxel's centre lies on: the marching cubes
+// read values at voxel centres, and a point's own side can differ from its centre's by up to
+// half a voxel (binning raw values shifted a sphere's surface by 0.8 voxel).
 class LeafQueries {
  public:
-  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DepthView& view,
-              const DistanceWeightGrid& fused, size_t leaf, const Eigen::Vector3d& origin)
-      : config_(config), local_(local), view_(view), leaf_(leaf), origin_(origin), vg_(config.global_voxel),
-        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()),
-        near_acc_(local.near.getConstAccessor()) {}
+  LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
+              size_t leaf, const Eigen::Vector3d& origin)
+      : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
+        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()) {}
 
-  std::vector<QueryUpdate> updates;
-  std::vector<openvdb::Coord> carved;
+  std::vector<Vote> votes;
 
-  // A training point p of this leaf: p itself, points behind it and in front of it, its ray.
   void add(const Eigen::Vector3d& p) {
     Eigen::Vector3d u = origin_ - p;
     const double range = u.norm();
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
-    {
-      // p is a centroid inside this leaf, so this leaf's GP is its nearest: no lookup.
-      const GpPrediction pred = local_.gps.gps[leaf_].predict(p, config_.inverse_variance_fusion);
-      const double d = pred.valid ? pred.distance : 0.0;
-      fuse(p, -d, normal.isZero() ? Eigen::Vector3d(-u) : Eigen::Vector3d(-normal),
-           pred.valid ? pred.variance : config_.variance_on_surface, Source::surface);
-    }
+    const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
+    const openvdb::Coord own = voxel_of(p, vg_);
+    // The GP's own distance at p (its surface fit misses p by that much) moves the value
+    // inward, as the first-order value at the centre: -d(p) - facing . (centre - p).
+    const GpPrediction at_p = gp_.predict(p, false);  // p lies in this leaf: its GP is the nearest
+    const double d = at_p.valid ? at_p.distance : 0.0;
+    votes.push_back({own, kSurface, static_cast<float>(-d - facing.dot(voxel_centre(own, vg_) - p))});
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
     // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
     if (normal.dot(u) > kMinNormalDotRay)
-      for (int j = 1; j <= config_.trunc_behind; ++j) fuse_query(p - j * config_.query_step * normal, 1.0);
+      for (int j = 1; j <= config_.trunc_behind; ++j) vote(p - j * config_.query_step * normal, p, facing, true);
     // Front points along the ray: the ray crossed that space, so it is free for sure.
-    for (int j = 1; j <= config_.trunc_front; ++j) fuse_query(p + j * config_.query_step * u, -1.0);
+    for (int j = 1; j <= config_.trunc_front; ++j) vote(p + j * config_.query_step * u, p, facing, false);
     if (config_.free_space_carving) carve(p, u, range);
   }
 
  private:
-  enum class Source { surface, behind, front };
-
-  // Fuses the signed value `value` at q with the signed field's gradient `toward_inside`.
-  void fuse(const Eigen::Vector3d& q, double value, const Eigen::Vector3d& toward_inside,
-            double variance, Source source) {
+  void vote(const Eigen::Vector3d& q, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, bool hit) {
     const openvdb::Coord v = voxel_of(q, vg_);
-    const Eigen::Vector3d centre = voxel_centre(v, vg_);
-    const double at_centre = value + toward_inside.dot(centre - q);
-    // Near the surface a free-space value needs the depth image's word for it. A surface
-    // point's value moved along a normal that an edge tilts can call free a centre the camera
-    // saw behind the surface, and a front point beside a grazing face a centre inside it.
-    if (source == Source::surface && at_centre < 0.0 && view_.seen_behind(centre, kBehindMargin * vg_)) return;
-    if (source == Source::front && near_acc_.isValueOn(v) && !view_.seen_in_front(centre)) return;
-    const bool hit = source != Source::front;
-    const float weight = config_.inverse_variance_fusion ? static_cast<float>(1.0 / variance) : 1.0f;
-    updates.push_back({v, static_cast<float>(at_centre), weight, hit});
-  }
-
-  // sign: +1 behind the surface, -1 in front of it.
-  void fuse_query(const Eigen::Vector3d& q, double sign) {
-    // The source point's own leaf among the candidates: the leaf nearest by centre can hold a
-    // patch far from q's foot point (measured on a sphere: front/carve value RMSE 2.0 -> 1.1 cm).
-    const GpPrediction pred = local_.gps.smallest(q, config_.inverse_variance_fusion, static_cast<int>(leaf_));
-    if (!pred.valid) return;  // f <= 0: no distance, skipped
-    fuse(q, sign * pred.distance, sign * pred.gradient, pred.variance, sign > 0.0 ? Source::behind : Source::front);
+    // A point behind whose centre lies in front of the plane sits astride the surface: the
+    // plane's offset is its value (the GPs' distance, to the nearest surface anywhere, would
+    // push the surface out). A point in front whose centre lies behind the plane is judged by
+    // the depth image at the centre (voxel_update).
+    const double offset = -facing.dot(voxel_centre(v, vg_) - p);  // > 0 behind the plane
+    if (hit && offset <= 0.0) {
+      votes.push_back({v, kSurface, static_cast<float>(offset)});
+      return;
+    }
+    if (!hit && offset > 0.0) {
+      votes.push_back({v, kFrontInside});
+      return;
+    }
+    votes.push_back({v, hit ? kHitInside : kFree});
   }
 
   // Every observed global voxel the ray crosses (DDA) from one carving step in front of p to
@@ -450,72 +456,135 @@ class LeafQueries {
         const openvdb::Coord v = dda.voxel();
         // A voxel on the block's edge may round into the neighbour: that block visits it.
         if (leaf_origin_of(v) != block || !(observed_.getValue(v)[1] > 0.0f)) continue;
-        carved.push_back(v);
+        votes.push_back({v, kFree});
       } while (dda.step());
     } while (blocks.step());
   }
 
   const VdbGpdfConfig& config_;
-  const LocalFrame& local_;
-  const DepthView& view_;
-  size_t leaf_;
+  const SurfaceGp& gp_;
   Eigen::Vector3d origin_;
   double vg_;
   DistanceWeightGrid::ConstAccessor observed_;
   PointSumGrid::ConstAccessor local_acc_;
-  openvdb::MaskGrid::ConstAccessor near_acc_;
 };
 
-// Stage "query_points": every local leaf's query updates, then the carving updates last.
-std::vector<std::vector<QueryUpdate>> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
-                                                    const DepthView& view,
-                                                    const DistanceWeightGrid& fused,
-                                                    const Eigen::Vector3d& origin) {
-  const size_t leaves = local.training.size();
-  std::vector<std::vector<QueryUpdate>> updates(leaves);
-  std::vector<std::vector<openvdb::Coord>> carved(leaves);  // voxels each leaf's rays cross
+// Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
+// order: the result does not depend on the thread count.
+void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface) {
+  auto acc = counts.getAccessor();
+  auto surface_acc = surface.getAccessor();
+  for (const auto& leaf_votes : votes)
+    for (const Vote& vote : leaf_votes) {
+      if (vote.kind == kSurface) {
+        openvdb::Vec4f sums = surface_acc.getValue(vote.voxel);
+        const int at = vote.offset > 0.0f ? 0 : 2;
+        sums[at] += vote.offset;
+        sums[at + 1] += 1.0f;
+        surface_acc.setValue(vote.voxel, sums);
+        acc.setValueOn(vote.voxel);  // every voted voxel is visited through `counts`
+        continue;
+      }
+      VoteCounts c = acc.getValue(vote.voxel);
+      ++c[vote.kind];
+      acc.setValue(vote.voxel, c);
+    }
+}
+
+// One voxel's update from its votes and the local GPs' distance d at its centre: each kept
+// vote adds +-d with one unit of weight. Near the surface a free-space value needs the depth
+// image's word for it (DepthView): a centre the camera saw behind the surface keeps no
+// negative "hit" vote (a surface point's plane, tilted by an edge, can call it free), and a
+// free vote near the surface needs the centre's pixel and its 8 neighbours to have measured
+// something farther (a front point or ray beside a grazing face passes a centre inside it).
+bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
+                  openvdb::Vec4f surface, const LocalGps& locals,
+                  const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
+  const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
+  if (surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) surface[2] = surface[3] = 0.0f;
+  if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
+  // A front point's centre behind the tangent plane: free if the camera saw through it, inside
+  // if its pixel saw the surface nearer, else unknown (beside a silhouette, where a curved or
+  // grazing surface's plane is no guide: a column's edge grew 8 cm into free space).
+  if (votes[kFrontInside] > 0) {
+    if (view.seen_in_front(c)) {
+      votes[kFree] += votes[kFrontInside];
+      votes[kFrontInside] = 0;
+    } else if (!view.seen_behind(c, kBehindMargin * config.global_voxel)) {
+      votes[kFrontInside] = 0;
+    }
+  }
+  const int inside = votes[kHitInside] + votes[kFrontInside];
+  const int free = votes[kFree];
+  const double surface_votes = surface[1] + surface[3];
+  const double weight = inside + free + surface_votes;
+  if (weight == 0.0) return false;
+  // Surface votes carry their own values: the GPs are asked only for the other votes' distance
+  // (or for the variance that inverse-variance fusion weights by).
+  double distance = 0.0, variance = config.variance_on_surface;
+  if (inside + free > 0 || config.inverse_variance_fusion) {
+    const GpPrediction pred = locals.smallest(c, config.inverse_variance_fusion);
+    if (!pred.valid) return false;
+    distance = pred.distance;
+    variance = pred.variance;
+  }
+  const double sum = surface[0] + surface[2] + distance * (inside - free);
+  out = {voxel, static_cast<float>(sum / weight),
+         static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
+         votes[kHitInside] + surface_votes > 0};
+  return true;
+}
+
+// Stage "query_points": every local leaf's votes, counted per global voxel, then one GP query
+// per voxel (in parallel, each voxel writing its own slot).
+std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
+                                       const DepthView& view, const DistanceWeightGrid& fused,
+                                       const Eigen::Vector3d& origin) {
+  const size_t leaves = local.sources.size();
+  std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, view, fused, leaf, origin);
+    LeafQueries queries(config, local, fused, leaf, origin);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
-    updates[leaf] = std::move(queries.updates);
-    carved[leaf] = std::move(queries.carved);
+    votes[leaf] = std::move(queries.votes);
   });
-  updates.push_back(carving_updates(config, carved, local.gps, local.near, view));
+  VoteGrid counts(VoteCounts(0));
+  SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
+  count_votes(votes, counts, surface);
+  std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
+  counts.tree().getNodes(vote_leaves);
+  std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
+  parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
+    const auto near = local.near.getConstAccessor();
+    const auto surface_acc = surface.getConstAccessor();
+    QueryUpdate update;
+    for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v)
+      if (voxel_update(config, v.getCoord(), *v, surface_acc.getValue(v.getCoord()), local.gps, near, view, update))
+        per_leaf[i].push_back(update);
+  });
+  std::vector<QueryUpdate> updates;
+  for (const auto& leaf_updates : per_leaf) updates.insert(updates.end(), leaf_updates.begin(), leaf_updates.end());
   return updates;
 }
 
-// Stage "fusion": sums the frame's updates per voxel (in a fixed order) into `frame_sums`, then
-// blends each touched voxel once by the fusion rule. Without a cap this equals one
-// running-average update per query point.
-void fuse_updates(const VdbGpdfConfig& config, const std::vector<std::vector<QueryUpdate>>& updates,
+// Stage "fusion": writes the frame's updates (one per voxel) into `frame_sums` as (sum of
+// w d, sum of w), then blends each touched voxel once by the fusion rule.
+void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& updates,
                   FusedGrid& fused, DistanceWeightGrid& frame_sums) {
-  openvdb::MaskGrid hits(false);
-  {
-    auto acc = frame_sums.getAccessor();
-    auto hit_acc = hits.getAccessor();
-    for (const auto& leaf_updates : updates)
-      for (const auto& u : leaf_updates) {
-
-        const openvdb::Vec2s v = acc.getValue(u.voxel);
-        acc.setValue(u.voxel, openvdb::Vec2s(v[0] + u.weight * u.distance, v[1] + u.weight));
-        if (u.hit) hit_acc.setValueOn(u.voxel);
-      }
-  }
+  auto sums = frame_sums.getAccessor();
   auto acc = fused.grid().getAccessor();
-  auto hit_acc = hits.getConstAccessor();
   const float vacated_below = static_cast<float>(-kVacatedVoxels * config.global_voxel);
-  for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
-    for (auto v = leaf->cbeginValueOn(); v; ++v) {
-      const openvdb::Vec2s sum = *v;
-      const openvdb::Vec2s old = acc.getValue(v.getCoord());
-      // Space the map knew as behind a surface that this frame sees only as free, by more
-      // than a voxel on average (so not the inside of a thin wall seen from its other side):
-      // the object has left, and this frame's value replaces the old one at once instead of
-      // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
-      // voxels only the floor's front queries reach, took 20 frames to clear).
-      const bool vacated = old[0] > 0.0f && !hit_acc.isValueOn(v.getCoord()) && sum[0] < vacated_below * sum[1];
-      acc.setValue(v.getCoord(), fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
-    }
+  for (const QueryUpdate& u : updates) {
+    const openvdb::Vec2s sum(u.weight * u.distance, u.weight);
+    sums.setValue(u.voxel, sum);
+    const openvdb::Vec2s old = acc.getValue(u.voxel);
+    // Space the map knew as behind a surface that this frame sees only as free, by more
+    // than a voxel on average (so not the inside of a thin wall seen from its other side):
+    // the object has left, and this frame's value replaces the old one at once instead of
+    // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
+    // voxels only the floor's front queries reach, took 20 frames to clear).
+    const bool vacated = old[0] > 0.0f && !u.hit && sum[0] < vacated_below * sum[1];
+    acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
+  }
 }
 
 // Runs one stage and records its wall time under `name`.
@@ -593,13 +662,12 @@ void VdbGpdf::integrate(const Frame& frame) {
   check_pose(frame);
   times_.stages.clear();
   const auto t_start = Clock::now();
-  const std::vector<Eigen::Vector3d> points = world_points(frame, config_.min_range, config_.max_range);
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
   LocalFrame local;
   const DepthView view(frame);
-  std::vector<std::vector<QueryUpdate>> updates;
+  std::vector<QueryUpdate> updates;
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
-  timed(times_, "voxelise", [&] { voxelise(config_, points, local); });
+  timed(times_, "voxelise", [&] { voxelise(config_, frame, view, local); });
   timed(times_, "local_gps", [&] { train_local_gps(config_.gp_params(), local); });
   timed(times_, "query_points", [&] { updates = query_updates(config_, local, view, fused_.grid(), origin); });
   timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });

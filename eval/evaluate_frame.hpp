@@ -11,6 +11,7 @@
 #include "core/types.hpp"
 #include "eval/ground_truth.hpp"
 #include "eval/metrics.hpp"
+#include "eval/moved_ghosts.hpp"
 
 #include <optional>
 #include <string>
@@ -44,6 +45,9 @@ struct FrameEvaluation {
   std::optional<EdfRaster> edf;
   RasterMetrics edf_circle;
   SlipStats slip;
+  // The moved objects' ghosts in the circle, when the run tracks them (eval/moved_ghosts.hpp:
+  // the tracker keeps state across frames, so the run adds this after evaluate_frame).
+  std::optional<MovedGhostFrame> moved;
   // Wall time of the stages, milliseconds: "truth" (with truth), "edf" (with a mapper).
   std::vector<std::pair<std::string, double>> times;
 };

@@ -7,6 +7,12 @@
 
 namespace sonomap::eval {
 
+bool is_ghost(const RasterCell& estimate, const RasterCell& truth, double tolerance) {
+  if (!estimate.known()) return false;
+  if (!truth.known()) return true;
+  return static_cast<double>(truth.range) - static_cast<double>(estimate.range) > tolerance;
+}
+
 RasterMetrics compare_cells(const std::vector<RasterCell>& estimate,
                             const std::vector<RasterCell>& truth, const MetricsConfig& config,
                             int row_width) {
@@ -40,15 +46,12 @@ RasterMetrics compare_cells(const std::vector<RasterCell>& estimate,
     if (edge) ++m.edge_cells;
     if (!e.known()) continue;
     ++m.estimate_known;
-    if (!t.known()) {
-      ++m.ghosts;
-      continue;
-    }
+    m.ghosts += is_ghost(e, t, config.ghost_tolerance);
+    if (!t.known()) continue;
     ++m.known_in_both;
     const double error = static_cast<double>(e.range) - static_cast<double>(t.range);
     squared_error_sum += error * error;
     if (!edge) off_edge_sum += error * error, ++off_edge_count;
-    if (-error > config.ghost_tolerance) ++m.ghosts;
   }
   m.coverage = m.truth_occupied > 0 ? static_cast<double>(m.known_in_both) / m.truth_occupied : NAN;
   m.rmse = m.known_in_both > 0 ? std::sqrt(squared_error_sum / m.known_in_both) : NAN;

@@ -36,6 +36,10 @@ struct RasterMetrics {
   int edge_cells = 0;  // truth-occupied cells on a silhouette edge
 };
 
+// The ghost rule of `ghosts`: the estimate knows the cell, and the truth is empty there or
+// farther than the estimate by more than `tolerance`.
+bool is_ghost(const RasterCell& estimate, const RasterCell& truth, double tolerance);
+
 // Throws std::invalid_argument if the rasters differ in shape or the tolerance is negative
 // or not finite.
 // `row_width` cells make one ring of azimuth neighbours (wrapping at 360 degrees); 0: no

@@ -48,6 +48,7 @@ DepthImage drop_out(const DepthImage& in, double p, const NoiseKey& key);
 // Model::None returns the input unchanged. Range limits are applied by the caller.
 // All stages run fused in one pass per row, the same image as running them one by one.
 // `out` is overwritten, its buffers reused.
+// The row loops run vectorised (vector_isa(); the same bits with any instruction set).
 void apply_noise(const DepthImage& truth, const NoiseSpec& spec, double focal_px, const NoiseKey& key,
                  DepthImage& out);
 DepthImage apply_noise(const DepthImage& truth, const NoiseSpec& spec, double focal_px, const NoiseKey& key);

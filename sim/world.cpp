@@ -3,6 +3,7 @@
 
 #include "sim/primitives.hpp"
 #include "sim/trajectory.hpp"
+#include "sim/vector_isa.hpp"
 #include "sim/world_geometry.hpp"
 
 #include <embree3/rtcore.h>
@@ -19,10 +20,6 @@
 namespace sonomap::sim {
 
 namespace {
-
-// 4x2 pixel tiles = one rtcIntersect8 packet, AVX2's native width (rtcIntersect16 is emulated
-// there and was slower).
-constexpr int kTileW = 4, kTileH = 2, kPacket = kTileW * kTileH;
 
 void throw_on_device_error(RTCDevice device, const char* what) {
   const RTCError error = rtcGetDeviceError(device);
@@ -80,6 +77,10 @@ struct World::Impl {
   RTCDevice device = nullptr;
   RTCScene top = nullptr;
   RTCScene statics = nullptr;
+  unsigned statics_id = RTC_INVALID_GEOMETRY_ID;  // the statics' instance in `top`
+  // The scene rays are cast into: `top`, or without movers the statics themselves (no
+  // instance to traverse; the same hits, as the statics' instance transform is the identity).
+  RTCScene traced = nullptr;
   std::vector<Mover> movers;
   // World rotation of each instance by its geometry id in `top` (to bring Embree's
   // object-space Ng into the world frame).
@@ -126,7 +127,7 @@ World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
   }
   w.statics = make_mesh_scene(w.device, merged, Eigen::Isometry3d::Identity(), RTC_BUILD_QUALITY_HIGH);
   RTCGeometry static_instance = nullptr;
-  w.add_instance(w.statics, static_instance);
+  w.statics_id = w.add_instance(w.statics, static_instance);
   rtcCommitGeometry(static_instance);
 
   w.movers.reserve(scenario.movers.size());
@@ -140,6 +141,7 @@ World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
     m.instance_id = w.add_instance(m.scene, m.instance);
     w.movers.push_back(m);
   }
+  w.traced = w.movers.empty() ? w.statics : w.top;
   set_time(0.0);
   throw_on_device_error(w.device, "building the world");
 }
@@ -164,82 +166,157 @@ void World::set_time(double t) {
 
 namespace {
 
+// 4x4 pixel tiles = one rtcIntersect16 packet: the widest Embree has, native with AVX-512
+// (and two AVX2 halves elsewhere); on the AVX-512 machine of docs/performance.md the rays cost
+// 40% less than with rtcIntersect8 on 4x2 tiles.
+constexpr int kTileW = 4, kTileH = 4, kPacket = kTileW * kTileH;
+
 // One packet of kTileW x kTileH rays: pixel i of the packet is (u0 + i % kTileW, v0 + i / kTileW).
 struct Packet {
-  alignas(32) RTCRayHit8 rayhit;
-  alignas(32) int valid[kPacket];  // rtcIntersect8 needs both 32-byte aligned
+  alignas(64) RTCRayHit16 rayhit;
+  alignas(64) int valid[kPacket];  // rtcIntersect16 needs both 64-byte aligned
+
+  // The fields no intersection changes, set once: origin, interval start, time, mask, flags.
+  explicit Packet(const Eigen::Vector3f& origin) {
+    RTCRay16& ray = rayhit.ray;
+    for (int i = 0; i < kPacket; ++i) {
+      ray.org_x[i] = origin.x();
+      ray.org_y[i] = origin.y();
+      ray.org_z[i] = origin.z();
+      ray.tnear[i] = 0.0f;
+      ray.time[i] = 0.0f;
+      ray.mask[i] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on: 0 would hit nothing
+      ray.id[i] = static_cast<unsigned>(i);
+      ray.flags[i] = 0;
+    }
+  }
 };
+
+// The rays' directions R (x_u, y_v, 1) (R = world_R_camera, x_u = (u - cx) / fx, y_v =
+// (v - cy) / fy) as a column term R.col(0) x_u plus a row term R.col(1) y_v + R.col(2),
+// summed in the order of Eigen's 3x3 float product, so that each ray is R * (x_u, y_v, 1) to
+// the bit; one addition per component and ray. Padded to whole tiles.
+struct RayDirections {
+  RayDirections(const PinholeRays& rays, int columns, int rows)
+      : column_x(columns), column_y(columns), column_z(columns), row(rows) {
+    const Eigen::Matrix3f r = rays.world_T_camera.linear().cast<float>();
+    for (int u = 0; u < columns; ++u) {
+      const auto x = static_cast<float>((static_cast<double>(u) - rays.cx) / rays.fx);
+      column_x[u] = r(0, 0) * x;
+      column_y[u] = r(1, 0) * x;
+      column_z[u] = r(2, 0) * x;
+    }
+    for (int v = 0; v < rows; ++v) {
+      const auto y = static_cast<float>((static_cast<double>(v) - rays.cy) / rays.fy);
+      row[v] = Eigen::Vector3f(r(0, 1) * y + r(0, 2), r(1, 1) * y + r(1, 2), r(2, 1) * y + r(2, 2));
+    }
+  }
+  std::vector<float> column_x, column_y, column_z;
+  std::vector<Eigen::Vector3f> row;
+};
+
+// A normal n seen through rotation r (Eigen's order for a 3x3 float product).
+Eigen::Vector3f rotated(const Eigen::Matrix3f& r, float x, float y, float z) {
+  return Eigen::Vector3f(r(0, 0) * x + (r(0, 1) * y + r(0, 2) * z), r(1, 0) * x + (r(1, 1) * y + r(1, 2) * z),
+                         r(2, 0) * x + (r(2, 1) * y + r(2, 2) * z));
+}
+
+// One image row's incidence angles from its hit depths (+infinity: nothing hit, angle 0), the
+// world normals n (x, y, z: one array each) and the ray directions d: acos of
+// d.n / sqrt(|d|^2 |n|^2), in double (one root instead of two normalisations).
+SONOMAP_VECTOR_LOOP void incidence_row(int width, const RayDirections& rays, int v, const float* __restrict z,
+                                       const float* __restrict nx, const float* __restrict ny,
+                                       const float* __restrict nz, float* __restrict incidence) {
+  const float row_x = rays.row[v].x(), row_y = rays.row[v].y(), row_z = rays.row[v].z();
+  const float* __restrict column_x = rays.column_x.data();
+  const float* __restrict column_y = rays.column_y.data();
+  const float* __restrict column_z = rays.column_z.data();
+  for (int u = 0; u < width; ++u) {
+    // The direction in float, as the ray was cast, then in double.
+    const double d0 = column_x[u] + row_x, d1 = column_y[u] + row_y, d2 = column_z[u] + row_z;
+    const double n0 = nx[u], n1 = ny[u], n2 = nz[u];
+    const double dn = (d0 * n0 + d1 * n1) + d2 * n2;
+    const double dd = (d0 * d0 + d1 * d1) + d2 * d2, nn = (n0 * n0 + n1 * n1) + n2 * n2;
+    const float angle = incidence_angle(static_cast<float>(dn / std::sqrt(dd * nn)));
+    incidence[u] = z[u] < std::numeric_limits<float>::infinity() ? angle : 0.0f;
+  }
+}
+
+void incidence_row_baseline(int width, const RayDirections& rays, int v, const float* z, const float* nx,
+                            const float* ny, const float* nz, float* incidence) {
+  incidence_row(width, rays, v, z, nx, ny, nz, incidence);
+}
+SONOMAP_AVX2_KERNEL void incidence_row_avx2(int width, const RayDirections& rays, int v, const float* z,
+                                            const float* nx, const float* ny, const float* nz, float* incidence) {
+  incidence_row(width, rays, v, z, nx, ny, nz, incidence);
+}
+SONOMAP_AVX512_KERNEL void incidence_row_avx512(int width, const RayDirections& rays, int v, const float* z,
+                                                const float* nx, const float* ny, const float* nz, float* incidence) {
+  incidence_row(width, rays, v, z, nx, ny, nz, incidence);
+}
 
 }  // namespace
 
 void World::cast(const PinholeRays& rays, RayHits& hits) const {
   const Impl& w = *impl_;
-  hits.width = rays.width;
-  hits.height = rays.height;
-  const std::size_t n = static_cast<std::size_t>(rays.width) * rays.height;
-  hits.z.resize(n);  // every pixel is written below
-  hits.incidence.resize(n);
-
-  const Eigen::Matrix3f world_R_camera = rays.world_T_camera.linear().cast<float>();
+  const int width = rays.width, height = rays.height;
+  hits.width = width;
+  hits.height = height;
+  hits.z.resize(static_cast<std::size_t>(width) * height);  // every pixel is written below
+  hits.incidence.resize(hits.z.size());
+  const int tiles_x = (width + kTileW - 1) / kTileW;
+  const int tiles_y = (height + kTileH - 1) / kTileH;
+  const RayDirections directions(rays, tiles_x * kTileW, tiles_y * kTileH);
   const Eigen::Vector3f origin = rays.world_T_camera.translation().cast<float>();
-  const int tiles_x = (rays.width + kTileW - 1) / kTileW;
-  const int tiles_y = (rays.height + kTileH - 1) / kTileH;
-  // Optical-frame direction components per column and per row (padded to whole tiles).
-  std::vector<float> x_of_column(static_cast<std::size_t>(tiles_x) * kTileW);
-  std::vector<float> y_of_row(static_cast<std::size_t>(tiles_y) * kTileH);
-  for (std::size_t u = 0; u < x_of_column.size(); ++u)
-    x_of_column[u] = static_cast<float>((static_cast<double>(u) - rays.cx) / rays.fx);
-  for (std::size_t v = 0; v < y_of_row.size(); ++v)
-    y_of_row[v] = static_cast<float>((static_cast<double>(v) - rays.cy) / rays.fy);
+  const auto incidence_of_row =
+      kernel_for(vector_isa(), &incidence_row_baseline, &incidence_row_avx2, &incidence_row_avx512);
 
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const tbb::blocked_range<int>& range) {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    Packet packet;
-    RTCRay8& ray = packet.rayhit.ray;
-    RTCHit8& hit = packet.rayhit.hit;
+    Packet packet(origin);
+    RTCRay16& ray = packet.rayhit.ray;
+    RTCHit16& hit = packet.rayhit.hit;
+    // World normals of a tile row's hits: x, y and z planes, each kTileH image rows.
+    const std::size_t row_stride = static_cast<std::size_t>(tiles_x) * kTileW, plane = kTileH * row_stride;
+    std::vector<float> normals(3 * plane);
     for (int ty = range.begin(); ty < range.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
-        Eigen::Vector3f direction[kPacket];
         for (int i = 0; i < kPacket; ++i) {
-          const int u = tx * kTileW + i % kTileW;
-          const int v = ty * kTileH + i / kTileW;
-          packet.valid[i] = (u < rays.width && v < rays.height) ? -1 : 0;
-          direction[i] = world_R_camera * Eigen::Vector3f(x_of_column[u], y_of_row[v], 1.0f);
-          ray.org_x[i] = origin.x();
-          ray.org_y[i] = origin.y();
-          ray.org_z[i] = origin.z();
-          ray.dir_x[i] = direction[i].x();
-          ray.dir_y[i] = direction[i].y();
-          ray.dir_z[i] = direction[i].z();
-          ray.tnear[i] = 0.0f;
+          const int u = tx * kTileW + i % kTileW, v = ty * kTileH + i / kTileW;
+          packet.valid[i] = (u < width && v < height) ? -1 : 0;
+          ray.dir_x[i] = directions.column_x[u] + directions.row[v].x();
+          ray.dir_y[i] = directions.column_y[u] + directions.row[v].y();
+          ray.dir_z[i] = directions.column_z[u] + directions.row[v].z();
           ray.tfar[i] = std::numeric_limits<float>::infinity();
-          ray.time[i] = 0.0f;
-          ray.mask[i] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on: 0 would hit nothing
-          ray.id[i] = static_cast<unsigned>(i);
-          ray.flags[i] = 0;
           hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
           hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect8(packet.valid, w.top, &context, &packet.rayhit);
-        float cosine[kPacket];  // of the incidence angle; 1 (angle 0) where nothing was hit
-        for (int i = 0; i < kPacket; ++i) {
-          cosine[i] = 1.0f;
-          if (!packet.valid[i] || hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-          const Eigen::Vector3f ng(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
-          // cos = d.n / (|d| |n|) in double: one root and one division instead of two normalisations.
-          const Eigen::Vector3d n = (w.instance_rotation[hit.instID[0][i]] * ng).cast<double>();
-          const Eigen::Vector3d d = direction[i].cast<double>();
-          cosine[i] = static_cast<float>(d.dot(n) / std::sqrt(d.squaredNorm() * n.squaredNorm()));
-        }
+        rtcIntersect16(packet.valid, w.traced, &context, &packet.rayhit);
         for (int i = 0; i < kPacket; ++i) {
           if (!packet.valid[i]) continue;
-          const std::size_t p = static_cast<std::size_t>(ty * kTileH + i / kTileW) * rays.width + tx * kTileW + i % kTileW;
+          const int u = tx * kTileW + i % kTileW, row = i / kTileW, v = ty * kTileH + row;
           const bool hit_something = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-          hits.z[p] = hit_something ? ray.tfar[i] : std::numeric_limits<float>::infinity();
-          hits.incidence[p] = incidence_angle(cosine[i]);
+          hits.z[static_cast<std::size_t>(v) * width + u] =
+              hit_something ? ray.tfar[i] : std::numeric_limits<float>::infinity();
+          // Embree gives a mover's normal in the mover's frame; the statics are in the world frame.
+          const unsigned instance = hit.instID[0][i];
+          const bool mover = hit_something && instance != RTC_INVALID_GEOMETRY_ID && instance != w.statics_id;
+          const Eigen::Vector3f n = mover
+                                        ? rotated(w.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i])
+                                        : Eigen::Vector3f(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
+          const std::size_t at = row * row_stride + u;
+          normals[at] = n.x();
+          normals[plane + at] = n.y();
+          normals[2 * plane + at] = n.z();
         }
+      }
+      for (int row = 0; row < kTileH && ty * kTileH + row < height; ++row) {
+        const int v = ty * kTileH + row;
+        const std::size_t at = row * row_stride, p = static_cast<std::size_t>(v) * width;
+        incidence_of_row(width, directions, v, hits.z.data() + p, normals.data() + at, normals.data() + plane + at,
+                         normals.data() + 2 * plane + at, hits.incidence.data() + p);
       }
     }
   });

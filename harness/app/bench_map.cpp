@@ -177,59 +177,71 @@ std::vector<Frame> render_frames(const sim::Scenario& scenario, const BenchMapOp
   return frames;
 }
 
-CellResult time_cell(const std::vector<Frame>& frames, const sim::Scenario& scenario, double voxel,
-                     int threads, const std::string& mapper, Progress& progress, long& done,
-                     std::optional<ReferenceCheck>& check,
-                     std::vector<Eigen::Vector3f>& tsdf_surface,
-                     std::vector<Eigen::Vector3f>& open3d_vertices) {
+// The Open3D reference check of a (voxel, threads) group, once every mapper has seen the frames.
+std::optional<ReferenceCheck> reference_check(const std::vector<Frame>& frames, const sim::Scenario& scenario,
+                                              double voxel, int threads,
+                                              const std::vector<std::pair<std::string, TimedMap*>>& maps) {
+  std::vector<Eigen::Vector3f> tsdf_surface, open3d_vertices;
+  for (const auto& [name, map] : maps) {
+    if (name == "tsdf") {
+      // Everything the camera reached: within its range of any camera position (the surface
+      // query's cost grows with the area of the radius, so no "infinite" radius).
+      const Eigen::Vector3d centre = frames.front().world_T_camera.translation();
+      double reach = 0.0;
+      for (const Frame& f : frames) reach = std::max(reach, (f.world_T_camera.translation() - centre).norm());
+      map->mapper().surface_points(centre, reach + scenario.camera.max_range + 1.0, tsdf_surface);
+    } else if (name == kOpen3d) {
+      std::vector<Eigen::Vector3i> triangles;
+      map->mapper().surface_mesh(open3d_vertices, triangles);
+    }
+  }
+  if (tsdf_surface.empty() || open3d_vertices.empty()) return std::nullopt;
+  return ReferenceCheck{voxel, threads, open3d_vertices.size(), tsdf_surface.size(),
+                        median_nearest_distance(open3d_vertices, tsdf_surface)};
+}
+
+// One (voxel, threads) group: every mapper integrates frame i before any integrates frame i + 1,
+// so a change in the machine's load hits all of them alike and their ratios stay fair.
+std::vector<CellResult> time_group(const std::vector<Frame>& frames, const sim::Scenario& scenario,
+                                   double voxel, int threads, const std::vector<std::string>& mappers,
+                                   Progress& progress, long& done, std::optional<ReferenceCheck>& check) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // Open3D's own OpenMP loops: their num_threads() clause follows omp_get_max_threads() only
   // when OMP_NUM_THREADS is set (otherwise they take every core), so set both.
   setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   omp_set_num_threads(threads);
-  CellResult cell;
-  cell.voxel = voxel;
-  cell.threads = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  cell.mapper = mapper;
-
-  TimedMap map(make_mapper(mapper, voxel, {}), scenario.ground_z);
-
+  const int active = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  std::vector<CellResult> cells(mappers.size());
+  std::vector<std::unique_ptr<TimedMap>> maps;
+  for (size_t m = 0; m < mappers.size(); ++m) {
+    cells[m].voxel = voxel;
+    cells[m].threads = active;
+    cells[m].mapper = mappers[m];
+    maps.push_back(std::make_unique<TimedMap>(make_mapper(mappers[m], voxel, {}), scenario.ground_z));
+  }
   StageList stages;
-  for (const Frame& frame : frames) {
-    stages.clear();
-    const double cpu_start = process_cpu_ms();
-    try {
-      map.process(frame, stages);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
+  for (const Frame& frame : frames)
+    for (size_t m = 0; m < mappers.size(); ++m) {
+      CellResult& cell = cells[m];
+      stages.clear();
+      const double cpu_start = process_cpu_ms();
+      try {
+        maps[m]->process(frame, stages);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
+      }
+      cell.frame_cpu_ms.push_back(process_cpu_ms() - cpu_start);
+      for (const auto& [name, ms] : stages) {
+        if (!cell.samples.count(name)) cell.stage_order.push_back(name);
+        cell.samples[name].push_back(ms);
+      }
+      cell.peak_map_bytes = std::max(cell.peak_map_bytes, maps[m]->mapper().memory_bytes());
+      progress.update(++done);
     }
-    cell.frame_cpu_ms.push_back(process_cpu_ms() - cpu_start);
-    for (const auto& [name, ms] : stages) {
-      if (!cell.samples.count(name)) cell.stage_order.push_back(name);
-      cell.samples[name].push_back(ms);
-    }
-    cell.peak_map_bytes = std::max(cell.peak_map_bytes, map.mapper().memory_bytes());
-    progress.update(++done);
-  }
-
-  // The reference check: Open3D's surface must be where our TSDF's is (same frames, same cell).
-  if (mapper == "tsdf") {
-    // Everything the camera reached: within its range of any camera position (the surface
-    // query's cost grows with the area of the radius, so no "infinite" radius).
-    tsdf_surface.clear();
-    const Eigen::Vector3d centre = frames.front().world_T_camera.translation();
-    double reach = 0.0;
-    for (const Frame& f : frames) reach = std::max(reach, (f.world_T_camera.translation() - centre).norm());
-    map.mapper().surface_points(centre, reach + scenario.camera.max_range + 1.0, tsdf_surface);
-  } else if (mapper == kOpen3d) {
-    std::vector<Eigen::Vector3i> triangles;
-    map.mapper().surface_mesh(open3d_vertices, triangles);
-  }
-  if ((mapper == "tsdf" || mapper == kOpen3d) && !tsdf_surface.empty() && !open3d_vertices.empty()) {
-    check = ReferenceCheck{voxel, cell.threads, open3d_vertices.size(), tsdf_surface.size(),
-                           median_nearest_distance(open3d_vertices, tsdf_surface)};
-  }
-  return cell;
+  std::vector<std::pair<std::string, TimedMap*>> named;
+  for (size_t m = 0; m < mappers.size(); ++m) named.emplace_back(mappers[m], maps[m].get());
+  check = reference_check(frames, scenario, voxel, active, named);
+  return cells;
 }
 
 std::string stage_summary(const CellResult& cell) {
@@ -238,6 +250,33 @@ std::string stage_summary(const CellResult& cell) {
     if (name != "map" && name != "frame" && name != "raster")
       text += fmt::format("{}{} {:.2f}", text.empty() ? "" : ", ", name, cell.median_of(name));
   return text;
+}
+
+// The other two figures, from the same run: per mapper and thread count, a coarser
+// voxel's median frame over the finest voxel's ("does a coarser map pay off?"); per mapper and
+// voxel, the one-thread median frame over each larger thread count's (the speed-up).
+struct Scaling {
+  std::string mapper;
+  double voxel = 0.0, to_voxel = 0.0;  // voxel -> to_voxel at `threads`
+  int threads = 0, to_threads = 0;     // threads -> to_threads at `voxel`
+  double value = NAN;
+};
+
+std::vector<Scaling> scalings(const std::vector<CellResult>& results) {
+  std::vector<Scaling> out;
+  for (const CellResult& base : results)
+    for (const CellResult& other : results) {
+      if (other.mapper != base.mapper || &other == &base) continue;
+      const double ratio = other.median_of("frame") / base.median_of("frame");
+      const bool finest = std::none_of(results.begin(), results.end(), [&](const CellResult& c) {
+        return c.mapper == base.mapper && c.threads == base.threads && c.voxel < base.voxel;
+      });
+      if (other.threads == base.threads && other.voxel > base.voxel && finest)
+        out.push_back({base.mapper, base.voxel, other.voxel, base.threads, base.threads, ratio});
+      if (other.voxel == base.voxel && base.threads == 1 && other.threads > 1)
+        out.push_back({base.mapper, base.voxel, base.voxel, 1, other.threads, 1.0 / ratio});
+    }
+  return out;
 }
 
 void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const std::vector<Frame>& frames,
@@ -275,6 +314,16 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
                               {"map_ratio_to_open3d", number(c.map_ratio)},
                               {"peak_map_bytes", c.peak_map_bytes}});
   }
+  out["voxel_scaling"] = json::array();
+  out["thread_speedup"] = json::array();
+  for (const Scaling& sc : scalings(results)) {
+    if (sc.voxel != sc.to_voxel)
+      out["voxel_scaling"].push_back({{"mapper", sc.mapper}, {"threads", sc.threads}, {"voxel", sc.voxel},
+                                      {"to_voxel", sc.to_voxel}, {"frame_ratio", number(sc.value)}});
+    else
+      out["thread_speedup"].push_back({{"mapper", sc.mapper}, {"voxel", sc.voxel}, {"threads", sc.to_threads},
+                                       {"speedup", number(sc.value)}});
+  }
   for (const ReferenceCheck& c : checks)
     out["open3d_checks"].push_back({{"voxel", c.voxel},
                                     {"threads", c.threads},
@@ -303,12 +352,9 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   std::vector<ReferenceCheck> checks;
   for (double voxel : o.voxels)
     for (int threads : o.threads) {
-      std::vector<Eigen::Vector3f> tsdf_surface;
-      std::vector<Eigen::Vector3f> open3d_vertices;
       std::optional<ReferenceCheck> check;
-      for (const std::string& mapper : o.mappers)
-        results.push_back(time_cell(frames, scenario, voxel, threads, mapper, progress, done, check,
-                                    tsdf_surface, open3d_vertices));
+      for (CellResult& cell : time_group(frames, scenario, voxel, threads, o.mappers, progress, done, check))
+        results.push_back(std::move(cell));
       if (check) checks.push_back(*check);
     }
   progress.finish();
@@ -345,6 +391,14 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
                "TSDF's {} surface samples {:.4f} m ({:.2f} voxels): {}\n",
                c.voxel, c.threads, c.open3d_vertices, c.tsdf_samples, c.median_distance,
                c.median_distance / c.voxel, c.passed() ? "ok" : "FAILED");
+  for (const Scaling& sc : scalings(results)) {
+    if (sc.voxel != sc.to_voxel)
+      fmt::print("{}, {} thread(s): frame at {:g} m / frame at {:g} m = {:.2f}\n", sc.mapper, sc.threads,
+                 sc.to_voxel, sc.voxel, sc.value);
+    else
+      fmt::print("{}, {:g} m: {} threads are {:.2f}x as fast as 1 (median frame)\n", sc.mapper, sc.voxel,
+                 sc.to_threads, sc.value);
+  }
   fmt::print("peak RSS: {:.1f} MB for the whole run ({:.1f} MB after rendering the frames)\n",
              rss_peak_mb, rss_frames_mb);
   if (!omp_wait_policy() && std::any_of(o.threads.begin(), o.threads.end(), [](int t) { return t > 1; }))

@@ -4,7 +4,10 @@
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/formats/sequence_io.hpp"
 #include "harness/support/errors.hpp"
+#include "sim/primitives.hpp"
 #include "sim/simulation.hpp"
+#include "sim/trajectory.hpp"
+#include "sim/world_geometry.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -35,6 +38,21 @@ class SimulatedSource final : public FrameSource {
   std::uint64_t seed() const override { return scenario_.seed; }
   std::optional<std::vector<sim::WorldTriangle>> truth(double t) const override {
     return sim::world_triangles(scenario_, t);
+  }
+  std::vector<eval::MovingObjectShape> moving_objects() const override {
+    std::vector<eval::MovingObjectShape> out;
+    for (const sim::MovingObject& mover : scenario_.movers) {
+      Eigen::AlignedBox3d box;
+      for (const Eigen::Vector3f& v : sim::mesh_of(mover.shape, mover.mesh).vertices) box.extend(v.cast<double>());
+      out.push_back({mover.name, box});
+    }
+    return out;
+  }
+  std::vector<std::optional<Eigen::Isometry3d>> moving_poses(double t) const override {
+    std::vector<std::optional<Eigen::Isometry3d>> out;
+    for (const sim::MovingObject& mover : scenario_.movers)
+      out.push_back(sim::is_present(mover, t) ? std::optional(sim::pose_at(mover.trajectory, t)) : std::nullopt);
+    return out;
   }
   std::vector<fs::path> inputs() const override { return inputs_; }
 

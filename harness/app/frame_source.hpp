@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "eval/moved_ghosts.hpp"
 #include "sim/scenario.hpp"
 #include "sim/world_geometry.hpp"
 
@@ -33,6 +34,10 @@ class FrameSource {
   virtual std::uint64_t seed() const = 0;
   // World triangles at time t, or nullopt when there is no ground truth (recorded data).
   virtual std::optional<std::vector<sim::WorldTriangle>> truth(double t) const = 0;
+  // The moving objects (their shapes' boxes) and their true poses at time t, one per object
+  // (none while it is out of the scene): what the moved-object ghosts are measured from.
+  virtual std::vector<eval::MovingObjectShape> moving_objects() const { return {}; }
+  virtual std::vector<std::optional<Eigen::Isometry3d>> moving_poses(double) const { return {}; }
   // A reference point cloud of a static scene (a recording's truth.cloud), or null: the truth
   // is then the minimum over its points in each cell (eval/cloud_truth.hpp).
   virtual const std::vector<Eigen::Vector3f>* truth_cloud() const { return nullptr; }

@@ -24,9 +24,24 @@ void apply(const FieldTable& table, const std::string& mapper, const std::vector
 
 // The factories. A config's own validation throws std::invalid_argument, which make_mapper()
 // reports as bad input naming the mapper.
+// --voxel (when > 0) sets VDB-GPDF's global voxel and scales the per-frame geometry with it:
+// the local grid, the GP lengthscale and where carving starts stay the same number of voxels
+// (2 cm, 3.3 cm and 5 cm at 5 cm), so a coarser map costs less per frame (at 10 cm a fixed
+// 2 cm local grid cost 90% of the 5 cm frame). The query step stays 5 cm: at 10 cm, steps
+// of 10 cm gave the room's circle and cylinder more error than 5 cm steps (mean RMSE 0.065 vs
+// 0.049 m and 0.234 vs 0.203 m, 150 frames).
+void set_voxel_scaling_frame_geometry(double voxel, VdbGpdfConfig& c) {
+  if (voxel <= 0) return;
+  const double scale = voxel / c.global_voxel;
+  c.local_voxel *= scale;
+  c.lambda /= scale * scale;
+  c.carving_step *= scale;
+  c.global_voxel = voxel;
+}
+
 std::unique_ptr<Mapper> make_vdb_gpdf(double voxel, const std::vector<Setting>& settings) {
   VdbGpdfConfig c;
-  if (voxel > 0) c.global_voxel = voxel;
+  set_voxel_scaling_frame_geometry(voxel, c);
   apply(vdb_gpdf_fields(c), "vdb_gpdf", settings);
   return std::make_unique<VdbGpdf>(c);
 }

@@ -81,6 +81,27 @@ eval::FrameEvaluation evaluate(const RunInputs& inputs, const Mapper& mapper,
   return evaluation;
 }
 
+// The tracker of moved objects' ghosts, for a source whose moving objects are known.
+std::optional<eval::MovedGhosts> moved_ghosts_tracker(const RunInputs& inputs) {
+  std::vector<eval::MovingObjectShape> objects = inputs.source->moving_objects();
+  if (objects.empty()) return std::nullopt;
+  const RunSettings& s = inputs.settings;
+  return eval::MovedGhosts(std::move(objects), {s.metrics.ghost_tolerance, inputs.source->ground_z(), s.raster});
+}
+
+// The frame's readings of moved objects' old places, from the true poses (stage "moved_ghosts").
+void track_moved_ghosts(eval::MovedGhosts& moved, const RunInputs& inputs, const SourceFrame& sensed,
+                        const Rasteriser& rasteriser, eval::FrameEvaluation& evaluation, FrameTimes& times) {
+  const auto t0 = StageClock::now();
+  const Frame& f = sensed.frame;
+  const Eigen::Isometry3d world_T_camera_true = sensed.world_T_body_true * f.world_T_body.inverse() * f.world_T_camera;
+  evaluation.moved = at_frame(f, [&] {
+    return moved.add_frame(f.index, inputs.source->moving_poses(f.time), rasteriser.circle(),
+                           evaluation.truth.circle, f, world_T_camera_true);
+  });
+  times.emplace_back("moved_ghosts", ms_since(t0));
+}
+
 }  // namespace
 
 RunOutcome run_scenario(const RunOptions& options) {
@@ -103,6 +124,7 @@ RunOutcome run_scenario(const RunOptions& options) {
     video.emplace(staged.path(), source.name(), mapper->name(), inputs.settings.raster,
                   schedule.frame_count(),
                   SweepClock{inputs.settings.listen.stream.period_s, inputs.settings.listen.stream.pause_s, 36});
+  std::optional<eval::MovedGhosts> moved = moved_ghosts_tracker(inputs);
   std::vector<Eigen::Vector3f> surface;
   Progress progress("run " + source.name(), schedule.frame_count(), options.quiet);
   for (int i = 0; i < schedule.frame_count(); ++i) {
@@ -114,8 +136,8 @@ RunOutcome run_scenario(const RunOptions& options) {
       const RasterOrigin origin = raster_origin(sensed.frame.world_T_body, source.ground_z());
       rasterise(*mapper, origin, rasteriser, surface, times);
       const bool with_edf = schedule.edf(i, results.evaluated_frames());
-      const eval::FrameEvaluation evaluation =
-          evaluate(inputs, *mapper, sensed, rasteriser, with_edf, times);
+      eval::FrameEvaluation evaluation = evaluate(inputs, *mapper, sensed, rasteriser, with_edf, times);
+      if (moved) track_moved_ghosts(*moved, inputs, sensed, rasteriser, evaluation, times);
       const FrameView view{i, sensed.frame.time, origin, &rasteriser.circle(),
                            &rasteriser.cylinder(), &surface, &evaluation};
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
@@ -131,6 +153,7 @@ RunOutcome run_scenario(const RunOptions& options) {
 
   RunSummary summary = describe_run(options, inputs, *mapper);
   results.fill_metrics(summary, inputs.settings.edf_enabled);
+  if (moved) summary.moved_objects = moved->results();
   summary.sweeps = outputs.sweep_levels();
   if (listen) summary.listen = listen->finish(schedule.frame_count());
   if (video)  // the listening stream is the sound track (--video implies --listen)
@@ -165,6 +188,16 @@ std::string summary_screen(const RunOutcome& outcome) {
     text += final_cells("edf circle", *s.edf_circle) +
             fmt::format("   EDF bearing slip: median {}, p90 {}\n",
                         cell(slip.median_deg, "{:.1f} deg"), cell(slip.p90_deg, "{:.1f} deg"));
+  }
+  for (const eval::MovedObjectClearing& m : s.moved_objects) {
+    if (!m.seen_empty_frame)
+      text += fmt::format("  moved {}: old place never seen empty\n", m.name);
+    else if (m.cleared())
+      text += fmt::format("  moved {}: ghosts cleared {} frames after its old place was seen empty (frame {})\n",
+                          m.name, *m.clearing_frames, *m.seen_empty_frame);
+    else
+      text += fmt::format("  moved {}: ghosts never cleared, {} bins left (old place seen empty at frame {})\n",
+                          m.name, m.ghost_bins_at_end, *m.seen_empty_frame);
   }
   text += fmt::format("  results: {}\n", outcome.dir.string());
   return text;

@@ -46,7 +46,7 @@ std::string frames_csv_header() {
          "circle_coverage,circle_rmse,circle_rmse_off_edges,circle_ghosts,circle_known,"
          "cylinder_coverage,cylinder_rmse,cylinder_rmse_off_edges,cylinder_ghosts,"
          "cylinder_known,edf_coverage,edf_rmse,edf_rmse_off_edges,edf_ghosts,edf_known,"
-         "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known\n";
+         "edf_slip_median_deg,edf_slip_p90_deg,edf_slip_known,circle_moved_ghosts\n";
 }
 
 std::string frames_csv_row(const FrameRow& r) {
@@ -58,6 +58,7 @@ std::string frames_csv_row(const FrameRow& r) {
             ',' + csv_number(r.slip.p90_deg) + ',' + std::to_string(r.slip.observed);
   else
     line += ",,,,,,,,";
+  line += ',' + (r.moved_ghosts ? std::to_string(*r.moved_ghosts) : std::string());
   return line + '\n';
 }
 
@@ -98,8 +99,9 @@ void write_result_file(const fs::path& path, const std::string& text) {
 FrameRow FrameRow::of(int frame, double time, const Eigen::Isometry3d& world_T_body_true,
                       const eval::FrameEvaluation& evaluation) {
   FrameRow row{frame, time, world_T_body_true, evaluation.has_truth, evaluation.circle,
-               evaluation.cylinder, std::nullopt, evaluation.slip};
+               evaluation.cylinder, std::nullopt, evaluation.slip, std::nullopt};
   if (evaluation.edf) row.edf_circle = evaluation.edf_circle;
+  if (evaluation.moved) row.moved_ghosts = evaluation.moved->bins;
   return row;
 }
 

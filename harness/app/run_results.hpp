@@ -73,6 +73,7 @@ struct FrameRow {
   std::optional<eval::RasterMetrics> cylinder;    // empty cells: no cylinder (score without one)
   std::optional<eval::RasterMetrics> edf_circle;  // frames with the EDF comparison
   SlipStats slip;
+  std::optional<int> moved_ghosts;  // ghost bins reading a place a moving object has left
   static FrameRow of(int frame, double time, const Eigen::Isometry3d& world_T_body_true,
                      const eval::FrameEvaluation& evaluation);
 };

@@ -91,6 +91,32 @@ EdfSummary edf_summary_of(const json& j) {
   return e;
 }
 
+json optional_int(const std::optional<int>& v) { return v ? json(*v) : json(nullptr); }
+std::optional<int> optional_int_of(const json& v) { return v.is_null() ? std::nullopt : std::optional(v.get<int>()); }
+
+json moved_object_json(const eval::MovedObjectClearing& m) {
+  return json{{"name", m.name},
+              {"seen_empty_frame", optional_int(m.seen_empty_frame)},
+              {"cleared", m.cleared()},
+              {"clearing_frames", optional_int(m.clearing_frames)},
+              {"ghost_bins_at_end", m.ghost_bins_at_end},
+              {"unseen_ghost_bins_at_end", m.unseen_ghost_bins_at_end},
+              {"max_ghost_bins", m.max_ghost_bins},
+              {"ghost_frames", m.ghost_frames}};
+}
+
+eval::MovedObjectClearing moved_object_of(const json& j) {
+  eval::MovedObjectClearing m;
+  j.at("name").get_to(m.name);
+  m.seen_empty_frame = optional_int_of(j.at("seen_empty_frame"));
+  m.clearing_frames = optional_int_of(j.at("clearing_frames"));
+  j.at("ghost_bins_at_end").get_to(m.ghost_bins_at_end);
+  j.at("unseen_ghost_bins_at_end").get_to(m.unseen_ghost_bins_at_end);
+  j.at("max_ghost_bins").get_to(m.max_ghost_bins);
+  j.at("ghost_frames").get_to(m.ghost_frames);
+  return m;
+}
+
 template <typename T>
 T read_json_file(const fs::path& file) {
   std::ifstream in(file);
@@ -225,6 +251,8 @@ void to_json(json& j, const RunSummary& s) {
   for (const SweepLevel& l : s.sweeps)
     j["sweeps"].push_back({{"file", l.file}, {"gain_db", l.gain_db}, {"loudness_lufs", l.loudness_lufs},
                            {"true_peak_dbtp", l.true_peak_dbtp}, {"peak_limited", l.peak_limited}});
+  j["moved_objects"] = json::array();
+  for (const eval::MovedObjectClearing& m : s.moved_objects) j["moved_objects"].push_back(moved_object_json(m));
   if (s.listen) {
     const ListenSummary& l = *s.listen;
     j["listen"] = {{"file", l.file}, {"mode", l.mode}, {"duration_s", l.duration_s},
@@ -265,6 +293,7 @@ void from_json(const json& j, RunSummary& s) {
     s.sweeps.push_back({l.at("file").get<std::string>(), l.at("gain_db").get<double>(),
                         number_of(l.at("loudness_lufs")), number_of(l.at("true_peak_dbtp")),
                         l.at("peak_limited").get<bool>()});
+  for (const json& m : j.value("moved_objects", json::array())) s.moved_objects.push_back(moved_object_of(m));
   if (j.contains("listen")) {
     const json& l = j.at("listen");
     const json& where = l.at("localisation");

@@ -8,6 +8,7 @@
 #include "core/edf_raster.hpp"
 #include "core/raster.hpp"
 #include "eval/metrics.hpp"
+#include "eval/moved_ghosts.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -111,6 +112,9 @@ struct RunSummary {
   std::vector<SweepLevel> sweeps;
   std::optional<ListenSummary> listen;
   std::optional<ScoredFiles> scored;  // score only
+  // Per moving object of a simulated scenario, how its ghosts in the circle cleared
+  // (docs/conventions.md "Moved-object ghosts"); empty without moving objects.
+  std::vector<eval::MovedObjectClearing> moved_objects;
 };
 
 // timings.json: per stage, the median wall time over the frames it ran in.

@@ -239,6 +239,27 @@ std::string edf_table(const std::vector<const RunRecord*>& list) {
   return md.str() + "\n";
 }
 
+// Per run and moving object: when its old place was first seen empty, how many frames its
+// ghosts in the circle took to clear after that, and the ghost bins left at the end.
+std::string moved_objects_table(const std::vector<const RunRecord*>& list) {
+  std::ostringstream md;
+  md << "### Moved objects\n\n"
+     << "Ghost clearing (docs/conventions.md): frames from the moment a part of the object's old "
+        "place is seen empty until no circle bin reads it, the worst over its old places; "
+        "\"never\" when bins still read a seen-empty old place at the last frame.\n\n"
+     << "| run | mapper | object | seen empty at frame | clearing frames | ghost bins left (seen / unseen) "
+        "| most ghost bins | frames with ghosts |\n"
+     << "|---|---|---|---|---|---|---|---|\n";
+  const auto frame_cell = [](const std::optional<int>& v) { return v ? std::to_string(*v) : std::string("-"); };
+  for (const RunRecord* r : list)
+    for (const eval::MovedObjectClearing& m : r->summary.moved_objects)
+      md << "| " << r->id << " | " << r->mapper << " | " << m.name << " | " << frame_cell(m.seen_empty_frame)
+         << " | " << (m.cleared() ? std::to_string(*m.clearing_frames) : m.seen_empty_frame ? "never" : "-")
+         << " | " << m.ghost_bins_at_end << " / " << m.unseen_ghost_bins_at_end << " | " << m.max_ghost_bins
+         << " | " << m.ghost_frames << " |\n";
+  return md.str() + "\n";
+}
+
 // A scenario's plots over frames and of time against voxel size, drawn into dir/plots.
 std::string scenario_plots(const fs::path& dir, const std::string& scenario,
                            const std::vector<const RunRecord*>& list, const std::vector<std::string>& stages) {
@@ -247,7 +268,8 @@ std::string scenario_plots(const fs::path& dir, const std::string& scenario,
       {"circle_rmse", "circle RMSE (m)"},     {"cylinder_rmse", "cylinder RMSE (m)"},
       {"circle_rmse_off_edges", "circle RMSE off silhouette edges (m)"},
       {"cylinder_rmse_off_edges", "cylinder RMSE off silhouette edges (m)"},
-      {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"}};
+      {"circle_ghosts", "circle ghost bins"}, {"cylinder_ghosts", "cylinder ghost cells"},
+      {"circle_moved_ghosts", "circle ghost bins in places moved objects left"}};
   std::ostringstream md;
   for (const auto& [column, label] : series) {
     const std::string name = scenario + "_" + column + ".png";
@@ -293,6 +315,8 @@ ReportOutcome build_report(const fs::path& dir, bool quiet, const fs::path& juni
     md << "## " << scenario << "\n\n" << runs_table(list);
     if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return r->summary.edf.has_value(); }))
       md << edf_table(list);
+    if (std::any_of(list.begin(), list.end(), [](const RunRecord* r) { return !r->summary.moved_objects.empty(); }))
+      md << moved_objects_table(list);
     md << scenario_plots(dir, scenario, list, stages);
   }
   write_text_file(dir / "report.md", md.str());

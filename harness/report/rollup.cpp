@@ -31,6 +31,20 @@ std::pair<FourMetrics, FourMetrics> final_and_mean(const RasterSummary* r) {
   return {final_frame, mean};
 }
 
+// The moved objects' ghosts as three numbers: the worst clearing (frames; undefined when an
+// object never cleared or none was seen empty), the ghost bins left at the end and the objects
+// that never cleared (all undefined without moving objects).
+std::array<double, 3> moved_ghost_figures(const std::vector<eval::MovedObjectClearing>& objects) {
+  if (objects.empty()) return {NAN, NAN, NAN};
+  double worst = NAN, left = 0, uncleared = 0;
+  for (const eval::MovedObjectClearing& m : objects) {
+    left += m.ghost_bins_at_end;
+    if (m.seen_empty_frame && !m.cleared()) ++uncleared;
+    if (m.clearing_frames) worst = std::isfinite(worst) ? std::max<double>(worst, *m.clearing_frames) : *m.clearing_frames;
+  }
+  return {uncleared > 0 ? NAN : worst, left, uncleared};
+}
+
 }  // namespace
 
 std::vector<std::string> split_csv_line(const std::string& line) {
@@ -95,6 +109,9 @@ std::vector<std::pair<std::string, std::string>> summary_metrics(const RunSummar
     for (int n = 0; n < 2; ++n)
       out.emplace_back(fmt::format("edf_slip_{}_{}", w ? "mean" : "final", n ? "p90_deg" : "median_deg"),
                        number_text(slip[w][n], "{:.2f}"));
+  const auto moved = moved_ghost_figures(summary.moved_objects);
+  const char* moved_names[] = {"moved_ghosts_clearing_frames", "moved_ghosts_at_end", "moved_ghosts_uncleared"};
+  for (std::size_t i = 0; i < moved.size(); ++i) out.emplace_back(moved_names[i], number_text(moved[i], "{:.0f}"));
   return out;
 }
 

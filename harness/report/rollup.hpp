@@ -30,7 +30,8 @@ struct RollupTable {
 };
 
 // A result directory's metrics under their rollup.csv names (circle_final_coverage, ...,
-// edf_slip_mean_p90_deg), from its summary; "" where a metric is undefined or absent.
+// edf_slip_mean_p90_deg, moved_ghosts_clearing_frames, moved_ghosts_at_end,
+// moved_ghosts_uncleared), from its summary; "" where a metric is undefined or absent.
 std::vector<std::pair<std::string, std::string>> summary_metrics(const RunSummary& summary);
 
 }  // namespace sonomap::harness

@@ -72,6 +72,33 @@ TEST_CASE("bench map times every stage of every mapper and Open3D's surface agre
   CHECK(bench.at("peak_rss_mb").get<double>() > 0.0);
 }
 
+TEST_CASE("bench map reports what a coarser voxel and a second thread change, per mapper", "[cli][bench]") {
+  const sonomap::test::ScratchDir scratch("bench-map-scaling");
+  const fs::path file = scratch.path() / "bench.json";
+  const auto result = run_sonomap({"-q", "bench", "map", sonomap::test::shipped("scenes/smoke.yaml").string(),
+                                   "--frames", "2", "--voxels", "0.1,0.2", "--threads-list", "1,2",
+                                   "--mappers", "vdb_gpdf,open3d", "--json", file.string()});
+  INFO(result.output);
+  REQUIRE(result.status == 0);
+  const json bench = json::parse(sonomap::test::text_of(file));
+  // Per mapper: 0.2 against 0.1 m at 1 and at 2 threads; 2 threads against 1 at each voxel.
+  std::set<std::string> scaled, sped_up;
+  for (const json& row : bench.at("voxel_scaling")) {
+    CHECK(row.at("voxel").get<double>() == Approx(0.1));
+    CHECK(row.at("to_voxel").get<double>() == Approx(0.2));
+    CHECK(row.at("frame_ratio").get<double>() > 0.0);
+    scaled.insert(row.at("mapper").get<std::string>() + "@" + std::to_string(row.at("threads").get<int>()));
+  }
+  for (const json& row : bench.at("thread_speedup")) {
+    CHECK(row.at("threads").get<int>() == 2);
+    CHECK(row.at("speedup").get<double>() > 0.0);
+    sped_up.insert(row.at("mapper").get<std::string>() + "@" + std::to_string(row.at("voxel").get<double>()));
+  }
+  CHECK(scaled == std::set<std::string>{"vdb_gpdf@1", "vdb_gpdf@2", "open3d@1", "open3d@2"});
+  CHECK(sped_up.size() == 4);
+  CHECK(result.output.find("2 threads are") != std::string::npos);
+}
+
 TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0 and no frames, writing nothing",
           "[cli][bench]") {
   const sonomap::test::ScratchDir scratch("bench-map-bad");

@@ -2,6 +2,7 @@
 // The shipped scenes parse and hold what their comments promise: the Cow-and-Lady-sized room,
 // obstacle sizes, a full look-around, a person crossing the view.
 #include "harness/formats/scenario_yaml.hpp"
+#include "sim/primitives.hpp"
 #include "sim/trajectory.hpp"
 #include "test_scenario_files.hpp"
 
@@ -141,4 +142,28 @@ TEST_CASE("smoke.yaml: a short scene with every primitive, a mesh and a mover", 
   std::set<PrimitiveSpec::Kind> kinds;
   for (const auto& o : s.statics) kinds.insert(o.shape.kind);
   CHECK(kinds.size() == 5);  // room, box, cylinder, sphere, mesh
+}
+
+TEST_CASE("large_object_leaves.yaml: a cabinet in view jumps 1.5 m aside between frames 30 and 31",
+          "[scenario][scenes]") {
+  const auto s = load_scenario(shipped("scenes/large_object_leaves.yaml"));
+  CHECK(s.frames == 120);  // 4 s at 30 Hz
+  REQUIRE(s.movers.size() == 1);
+  const auto& cabinet = s.movers[0];
+  CHECK(cabinet.name == "cabinet");
+  const auto at = [&](double t) {
+    return world_bounds(sonomap::sim::mesh_of(cabinet.shape, cabinet.mesh), sonomap::sim::pose_at(cabinet.trajectory, t));
+  };
+  const Bounds before = at(30 / 30.0), after = at(31 / 30.0);
+  CHECK(before.size().isApprox(Eigen::Vector3d(0.7, 0.9, 1.7), 1e-6));  // float vertices
+  CHECK(before.lo.x() == Approx(-1.15));  // the front face 1.35 m ahead of the listener at x = -2.5
+  CHECK(after.lo.y() == Approx(before.lo.y() - 1.5));
+  CHECK(after.hi.y() < before.lo.y());  // its old place is wholly vacated
+  // From frame 31 the camera looks through the old place: the middle of its front face (1.2 m
+  // up) and the wall behind it are in view (the room holds nothing else in between); the
+  // cabinet's new front face is not.
+  const Eigen::Isometry3d camera = sonomap::sim::pose_at(s.body, 31 / 30.0) * s.camera.body_T_camera;
+  CHECK(in_view(s.camera, camera, Eigen::Vector3d(-1.15, 0.0, 1.2)));
+  CHECK(in_view(s.camera, camera, Eigen::Vector3d(0.45, 0.0, 1.2)));  // the wall behind it
+  CHECK_FALSE(in_view(s.camera, camera, Eigen::Vector3d(-1.15, -1.5, 1.2)));  // its new front face
 }

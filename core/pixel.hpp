@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The pixel of a depth image that a point in the camera's optical frame (x right, y down,
+// z forward) falls in: what a mapper or an evaluator checks a point against the image with.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <optional>
+
+namespace sonomap {
+
+struct Pixel {
+  int u = 0, v = 0;
+};
+
+// The pixel whose centre is nearest the projection of camera-frame point `c`; none behind the
+// camera, outside the width x height image, or for a non-finite projection.
+inline std::optional<Pixel> pixel_of(const PinholeIntrinsics& k, int width, int height, const Eigen::Vector3d& c) {
+  if (!(c.z() > 0.0)) return std::nullopt;
+  const double u = std::round(k.fx * c.x() / c.z() + k.cx), v = std::round(k.fy * c.y() / c.z() + k.cy);
+  if (!(u >= 0.0 && v >= 0.0 && u < width && v < height)) return std::nullopt;
+  return Pixel{static_cast<int>(u), static_cast<int>(v)};
+}
+
+}  // namespace sonomap

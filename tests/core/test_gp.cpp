@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The local surface GP (core/gp.hpp) as a distance sensor: trained on points of a plane, it
+// reads the height above the plane; and its SIMD float prediction agrees with the textbook
+// formula evaluated here in double precision (an independent path: Eigen's own solve).
+#include "core/gp.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <vector>
+
+using namespace sonomap;
+
+namespace {
+
+// A 16 cm patch of the plane z = 1.2, points 4 cm apart (a local leaf's training points).
+std::vector<Eigen::Vector3f> plane_patch() {
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) points.emplace_back(3.0f + 0.04f * i, -1.0f + 0.04f * j, 1.2f);
+  return points;
+}
+
+// f = k(x)^T (K + noise I)^-1 1 and its distance, written out for the given kernel.
+double reference_distance(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
+  const bool se = p.kernel == GpKernel::RevertingSE;
+  const double a = se ? p.lambda : std::sqrt(3.0 * p.lambda);
+  auto k = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    const double r = (u - v).norm();
+    return se ? std::exp(-0.5 * a * r * r) : (1.0 + a * r) * std::exp(-a * r);
+  };
+  const int n = static_cast<int>(points.size());
+  Eigen::MatrixXd kk(n, n);
+  Eigen::VectorXd ks(n);
+  for (int i = 0; i < n; ++i) {
+    ks[i] = k(x, points[i].cast<double>());
+    for (int j = 0; j < n; ++j) kk(i, j) = k(points[i].cast<double>(), points[j].cast<double>()) + (i == j ? p.noise : 0.0);
+  }
+  const double f = ks.dot(kk.ldlt().solve(Eigen::VectorXd::Ones(n)));
+  return se ? std::sqrt(2.0 * std::abs(std::log(f)) / a) : std::abs(std::log(f)) / a;
+}
+
+}  // namespace
+
+TEST_CASE("GP: over a patch of a plane, a point d above its middle reads d (d up to 6 cm)", "[gp]") {
+  SurfaceGp gp;
+  gp.train(plane_patch(), GpParams{});
+  for (double d : {0.0, 0.01, 0.02, 0.04, 0.06}) {
+    const GpPrediction p = gp.predict(Eigen::Vector3d(3.08, -0.92, 1.2 + d), false);
+    REQUIRE(p.valid);
+    CHECK(p.distance == Approx(d).margin(0.005));
+    if (d > 0.0) CHECK(p.gradient.z() > 0.99);  // straight away from the plane
+  }
+}
+
+TEST_CASE("GP: the float SIMD prediction matches the formula in double within 0.1 mm", "[gp]") {
+  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
+    GpParams params;
+    params.kernel = kernel;
+    SurfaceGp gp;
+    const auto points = plane_patch();
+    gp.train(points, params);
+    // Above, below, beside and past the patch's corner, near and up to 15 cm away.
+    for (const Eigen::Vector3d& x : {Eigen::Vector3d(3.05, -0.95, 1.23), Eigen::Vector3d(3.11, -0.9, 1.1),
+                                    Eigen::Vector3d(2.95, -1.05, 1.2), Eigen::Vector3d(3.2, -0.8, 1.3),
+                                    Eigen::Vector3d(3.08, -0.92, 1.35)}) {
+      const GpPrediction p = gp.predict(x, false);
+      REQUIRE(p.valid);
+      CHECK(p.distance == Approx(reference_distance(points, params, x)).margin(1e-4));
+    }
+  }
+}
+
+TEST_CASE("GP: a point with 1, 3 and 5 training points (not whole SIMD vectors) reads its distance", "[gp]") {
+  for (size_t n : {1u, 3u, 5u}) {
+    std::vector<Eigen::Vector3f> points;
+    for (size_t i = 0; i < n; ++i) points.emplace_back(0.02f * i, 0.0f, 0.0f);
+    SurfaceGp gp;
+    gp.train(points, GpParams{});
+    const Eigen::Vector3d x(0.0, 0.0, 0.03);
+    CHECK(gp.predict(x, false).distance == Approx(reference_distance(points, GpParams{}, x)).margin(1e-4));
+  }
+}
