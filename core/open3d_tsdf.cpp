@@ -125,6 +125,7 @@ void Open3dTsdf::integrate(const Frame& frame) {
 void Open3dTsdf::surface_points(const Eigen::Vector3d& center, double radius,
                                 std::vector<Eigen::Vector3f>& out) const {
   volume_->refresh_surface(config_.voxel);
+  out.clear();
   const Eigen::Vector2f c = center.head<2>().cast<float>();
   const float r2 = static_cast<float>(radius * radius);
   for (const Eigen::Vector3f& p : volume_->samples)

@@ -4,6 +4,7 @@
 #include "core/depth_only.hpp"
 #include "harness/app/mapper_registry.hpp"
 #include "harness/support/errors.hpp"
+#include "tests/core/test_vdb_gpdf_scene.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -75,4 +76,26 @@ TEST_CASE("mapper registry: malformed names, taken names and empty factories are
   CHECK_THROWS_AS(sonomap::register_mapper("once", recording_factory), std::invalid_argument);
   const auto names = mapper_names();
   CHECK(std::count(names.begin(), names.end(), "once") == 1);
+}
+
+TEST_CASE("mapper registry: every built-in mapper's surface_points replaces what the vector held") {
+  // A wall 2 m ahead of a camera 1.5 m up: asking twice gives the same samples, not twice as
+  // many, and a stale point left in the vector is gone (mapper.hpp: "Replaces `out`").
+  sonomap::test::Scene scene;
+  scene.boxes.push_back({Eigen::Vector3d(2.0, -1.5, 0.0), Eigen::Vector3d(2.2, 1.5, 2.0)});
+  const Eigen::Vector3d eye(0.0, 0.0, 1.5);
+  const Eigen::Isometry3d camera = sonomap::test::look_at(eye, Eigen::Vector3d(2.0, 0.0, 1.2));
+  const Eigen::Vector3f stale(-50.0f, -50.0f, -50.0f);
+  for (const std::string name : {"vdb_gpdf", "tsdf", "open3d", "depth_only"}) {
+    INFO(name);
+    const auto mapper = make_mapper(name, 0.05, {});
+    for (int i = 0; i < 3; ++i) mapper->integrate(sonomap::test::render(scene, camera, i));
+    std::vector<Eigen::Vector3f> out{stale};
+    mapper->surface_points(eye, 5.0, out);
+    const size_t first = out.size();
+    CHECK(first > 100);
+    CHECK(std::find(out.begin(), out.end(), stale) == out.end());
+    mapper->surface_points(eye, 5.0, out);
+    CHECK(out.size() == first);
+  }
 }
