@@ -101,6 +101,19 @@ inline void check_pose(const Frame& frame) {
                                 std::to_string(r.determinant()) + ")");
 }
 
+// Whether the frame carries a depth image that a projective integrator can read: pixels and
+// pinhole intrinsics. Throws std::invalid_argument naming the frame when it has pixels but
+// not width x height of them.
+inline bool has_depth_image(const Frame& frame) {
+  if (frame.depth.empty()) return false;
+  if (frame.width <= 0 || frame.height <= 0 ||
+      frame.depth.size() != static_cast<size_t>(frame.width) * frame.height)
+    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": the depth image has " +
+                                std::to_string(frame.depth.size()) + " pixels, not width x height = " +
+                                std::to_string(frame.width) + " x " + std::to_string(frame.height));
+  return frame.intrinsics.valid();
+}
+
 // The frame's points whose distance from the camera lies in [min_range, max_range], in the
 // world. Non-finite points are skipped (documented behaviour, not an error) and counted.
 inline std::vector<Eigen::Vector3d> world_points(const Frame& frame, double min_range,

@@ -201,11 +201,11 @@ std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed
   return out;
 }
 
-std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched) {
+std::vector<LeafChanges> leaf_changes(const openvdb::MaskGrid& touched) {
   std::vector<LeafChanges> changed;
   for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf)
     changed.push_back({leaf->origin(), leaf->getValueMask()});
-  return dirty_leaves(changed);
+  return changed;
 }
 
 void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples) {

@@ -76,8 +76,9 @@ struct LeafChanges {
 // Leaves that must be re-marched after the voxels in `touched` changed: each touched leaf and,
 // for voxels on a leaf's lower faces, the lower neighbours whose cubes reach into it.
 // Returned sorted (deterministic).
-std::vector<openvdb::Coord> dirty_leaves(const openvdb::MaskGrid& touched);
 std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed);
+// The active voxels of `touched`, leaf by leaf.
+std::vector<LeafChanges> leaf_changes(const openvdb::MaskGrid& touched);
 
 // Dense surface samples per leaf of a grid, refreshed leaf by leaf, queried by a horizontal
 // disc so the cost follows the queried area, not the whole map.

@@ -83,14 +83,9 @@ void Open3dTsdf::integrate(const Frame& frame) {
   times_.stages.clear();
   if (frame.depth.empty()) return;  // nothing to fuse
   const PinholeIntrinsics& k = frame.intrinsics;
-  const std::string where = "frame " + std::to_string(frame.index) + ": ";
-  if (frame.width <= 0 || frame.height <= 0 ||
-      frame.depth.size() != static_cast<size_t>(frame.width) * frame.height)
-    throw std::invalid_argument(where + "the depth image has " + std::to_string(frame.depth.size()) +
-                                " pixels, not width x height = " + std::to_string(frame.width) + " x " +
-                                std::to_string(frame.height));
-  if (!k.valid())
-    throw std::invalid_argument(where + "no pinhole intrinsics (fx, fy > 0, finite cx, cy): the open3d "
+  if (!has_depth_image(frame))
+    throw std::invalid_argument("frame " + std::to_string(frame.index) +
+                                ": no pinhole intrinsics (fx, fy > 0, finite cx, cy): the open3d "
                                 "mapper integrates the depth image");
   const auto t_start = StageClock::now();
   // The depth image as Open3D wants it (float metres, 0 = no return), pixels outside the

@@ -16,11 +16,19 @@ struct Pixel {
   int u = 0, v = 0;
 };
 
+// Where camera-frame point `c` projects, in pixels (pixel centres at whole numbers); none
+// behind the camera.
+inline std::optional<Eigen::Vector2d> projection(const PinholeIntrinsics& k, const Eigen::Vector3d& c) {
+  if (!(c.z() > 0.0)) return std::nullopt;
+  return Eigen::Vector2d(k.fx * c.x() / c.z() + k.cx, k.fy * c.y() / c.z() + k.cy);
+}
+
 // The pixel whose centre is nearest the projection of camera-frame point `c`; none behind the
 // camera, outside the width x height image, or for a non-finite projection.
 inline std::optional<Pixel> pixel_of(const PinholeIntrinsics& k, int width, int height, const Eigen::Vector3d& c) {
-  if (!(c.z() > 0.0)) return std::nullopt;
-  const double u = std::round(k.fx * c.x() / c.z() + k.cx), v = std::round(k.fy * c.y() / c.z() + k.cy);
+  const std::optional<Eigen::Vector2d> p = projection(k, c);
+  if (!p) return std::nullopt;
+  const double u = std::round(p->x()), v = std::round(p->y());
   if (!(u >= 0.0 && v >= 0.0 && u < width && v < height)) return std::nullopt;
   return Pixel{static_cast<int>(u), static_cast<int>(v)};
 }

@@ -74,16 +74,6 @@ class DepthImage {
   float fx_, fy_, cx_, cy_;  // cx_, cy_ include the half pixel that rounds to the nearest
 };
 
-bool has_depth_image(const Frame& frame) {
-  if (frame.depth.empty() || !frame.intrinsics.valid()) return false;
-  if (frame.width <= 0 || frame.height <= 0 ||
-      frame.depth.size() != static_cast<size_t>(frame.width) * frame.height)
-    throw std::invalid_argument("frame " + std::to_string(frame.index) + ": the depth image has " +
-                                std::to_string(frame.depth.size()) + " pixels, not width x height = " +
-                                std::to_string(frame.width) + " x " + std::to_string(frame.height));
-  return true;
-}
-
 // Marks in `blocks` (one voxel per leaf, at leaf origin / 8) every leaf that may hold a voxel
 // in the band of a return: within the truncation of the return along its ray and within
 // `slack` to the side. Per image row one set of half extents bounds that segment's box for
@@ -272,8 +262,7 @@ std::vector<LeafChanges> Tsdf::integrate_rays(const Frame& frame) {
       touch.setValueOn(ijk);
     } while (dda.step());
   }
-  std::vector<LeafChanges> changed;
-  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf) changed.push_back({leaf->origin(), leaf->getValueMask()});
+  std::vector<LeafChanges> changed = leaf_changes(touched);
   times_.stages.emplace_back("integrate", ms_since(t0));
   return changed;
 }

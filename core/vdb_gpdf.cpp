@@ -92,11 +92,10 @@ class DepthView {
   // Projects less than `pixels` inside the image's edge (or outside the image).
   bool at_edge(const Eigen::Vector3d& world, double pixels) const {
     if (!usable_) return false;
-    const Eigen::Vector3d c = camera_T_world_ * world;
-    if (!(c.z() > 0.0)) return false;
-    const PinholeIntrinsics& k = frame_.intrinsics;
-    const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
-    const double inset = std::min(std::min(u + 0.5, frame_.width - 0.5 - u), std::min(v + 0.5, frame_.height - 0.5 - v));
+    const std::optional<Eigen::Vector2d> p = projection(frame_.intrinsics, camera_T_world_ * world);
+    if (!p) return false;
+    const double inset = std::min(std::min(p->x() + 0.5, frame_.width - 0.5 - p->x()),
+                                  std::min(p->y() + 0.5, frame_.height - 0.5 - p->y()));
     return inset < pixels;
   }
 
@@ -681,7 +680,7 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
   std::unordered_map<openvdb::Coord, int, CoordHash> touched_count;
   for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
     touched_count[leaf->origin()] = static_cast<int>(leaf->onVoxelCount());
-  const std::vector<openvdb::Coord> dirty = dirty_leaves(touched);
+  const std::vector<openvdb::Coord> dirty = dirty_leaves(leaf_changes(touched));
 
   std::vector<SurfaceMesh> meshes = fused_.refresh(dirty);
   for (size_t i = 0; i < dirty.size(); ++i) {

@@ -200,12 +200,14 @@ struct Tally {
 };
 
 // The nearest truth a map can be held to in each bin: the farthest of the bin's exact truth
-// and the truths with the bins turned one pixel's angle either way (infinite where one of
-// them has no obstacle at all).
-std::vector<double> resolvable_truth(const std::vector<eval::GroundTruthTriangle>& triangles,
+// (`exact`) and the truths with the bins turned one pixel's angle either way (infinite where
+// one of them has no obstacle at all).
+std::vector<double> resolvable_truth(const std::vector<eval::GroundTruthTriangle>& triangles, const Circle& exact,
                                      const RasterOrigin& origin, const RasterConfig& config) {
-  std::vector<double> out(config.azimuth_bins, 0.0);
-  for (double turn : {-kPixelAngle, 0.0, kPixelAngle}) {
+  std::vector<double> out(config.azimuth_bins);
+  for (int b = 0; b < config.azimuth_bins; ++b)
+    out[b] = exact.bins[b].known() ? static_cast<double>(exact.bins[b].range) : HUGE_VAL;
+  for (double turn : {-kPixelAngle, kPixelAngle}) {
     RasterOrigin turned = origin;
     turned.heading += turn;
     const auto truth = eval::ground_truth_rasters(triangles, turned, config);
@@ -245,8 +247,9 @@ void run_room(uint64_t seed, std::vector<Tally>& tallies) {
     origin.position = camera.translation();
     origin.heading = heading * M_PI / 180.0;
     std::vector<Box> boxes{scene.boxes.begin() + 1, scene.boxes.end()};  // not the floor
-    const auto truth = eval::ground_truth_rasters(triangles_of(boxes), origin, config);
-    const std::vector<double> resolvable = resolvable_truth(triangles_of(boxes), origin, config);
+    const std::vector<eval::GroundTruthTriangle> triangles = triangles_of(boxes);
+    const auto truth = eval::ground_truth_rasters(triangles, origin, config);
+    const std::vector<double> resolvable = resolvable_truth(triangles, truth.circle, origin, config);
     const auto old_place = eval::ground_truth_rasters(triangles_of({room.mover_before}), origin, config);
     for (size_t m = 0; m < maps.size(); ++m) {
       std::vector<Eigen::Vector3f> samples;
