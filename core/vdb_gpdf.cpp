@@ -133,8 +133,9 @@ struct LocalGps {
   // neighbours from here instead of 26 lookups.
   void link_neighbours() {
     neighbours.assign(origins.size(), {});
-    for (size_t i = 0; i < origins.size(); ++i)
+    parallel_for_each_index(origins.size(), [&](size_t i) {
       for_each_neighbour(origins[i], [&](int j) { neighbours[i].push_back(j); });
+    });
   }
 
   // Calls f(index) for every leaf among the 26 around the leaf at `home`.
@@ -238,20 +239,6 @@ Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& local, const o
   return n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n;
 }
 
-// The global voxels holding one of the frame's points (their local voxels' centroids) and their
-// 26 neighbours. A ray proves free only the space it crosses, and the centre of a voxel it
-// crosses can lie up to 0.87 voxel off it, so next to a surface that centre can be behind the
-// surface. Rays grazing past a silhouette edge, a corner or a thin top carved the object's own
-// inside, hundreds of rays against one or two surface samples, and the circle lost the edge
-// (room, 300 frames: 69 bin readings too far by over 0.1 m, TSDF peer 15). In these voxels a
-// free-space value needs the depth image's word that the centre is free (DepthView).
-void near_surface(const PointSumGrid& local, double global_voxel, openvdb::MaskGrid& mask) {
-  auto acc = mask.getAccessor();
-  for (auto v = local.cbeginValueOn(); v; ++v) acc.setValueOn(voxel_of(centroid(*v), global_voxel));
-  openvdb::tools::dilateActiveValues(mask.tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                     openvdb::tools::IGNORE_TILES);
-}
-
 // What one query point or carving ray says of the global voxel it falls in. The value itself
 // is the local GPs' distance at the voxel's centre, computed once per voxel whatever the
 // number of votes (one GP query per touched voxel: a frame's 66k query points and carving
@@ -287,86 +274,239 @@ struct LocalFrame {
   openvdb::MaskGrid near{false};
 };
 
-void add_sparse_sources(double global_voxel, const DepthView& view, LocalFrame& local) {
-  // Per global voxel: how many local voxels hold points; -1 once it has a source.
-  openvdb::Int32Grid counts(0);
-  auto count = counts.getAccessor();
-  for (auto v = local.points.cbeginValueOn(); v; ++v) {
-    const openvdb::Coord g = voxel_of(centroid(*v), global_voxel);
-    count.setValue(g, count.getValue(g) + 1);
-  }
-  for (const auto& leaf_points : local.training)
-    for (const auto& p : leaf_points) count.setValue(voxel_of(p.cast<double>(), global_voxel), -1);
-  local.sources = local.training;
-  size_t leaf_index = 0;
-  for (auto leaf = local.points.tree().cbeginLeaf(); leaf; ++leaf, ++leaf_index)
-    for (auto v = leaf->cbeginValueOn(); v; ++v) {
-      const Eigen::Vector3d c = centroid(*v);
-      const openvdb::Coord g = voxel_of(c, global_voxel);
-      const int cells = count.getValue(g);
-      if (cells < 1 || (cells < kMinSparseCells && !view.at_edge(c, kEdgePixels))) continue;
-      count.setValue(g, -1);
-      local.sources[leaf_index].push_back(c.cast<float>());
-    }
+// Stage "voxelise", in parallel over a split of the work that never depends on the thread count
+// (kWorkParts chunks of the frame's points, kWorkParts buckets of local leaves, one task per
+// local leaf), and each voxel adds its terms in the serial order: the result is the serial one,
+// to the bit.
+constexpr size_t kWorkParts = 8;
+
+// The bucket of the local leaf holding voxel v: a hash of the leaf's index (its origin's low
+// bits are all zero).
+size_t bucket_of(const openvdb::Coord& v) {
+  return CoordHash{}(v >> PointSumGrid::TreeType::LeafNodeType::LOG2DIM) % kWorkParts;
 }
 
-// Stage "voxelise". Training points are the centroids of the frame's points per local voxel,
-// not the voxel centres: centres put a face up to half a local voxel inside or outside it.
+// One bucket's leaves of the point sums, built apart and then moved into the grid (a grid per
+// bucket would allocate top nodes of its own, 256 kB each, every frame).
+class PointSumLeaves {
+ public:
+  using Leaf = PointSumGrid::TreeType::LeafNodeType;
+
+  // Adds `sum` to voxel v's value and activates it.
+  void add(const openvdb::Coord& v, const openvdb::Vec4f& sum) {
+    Leaf& l = leaf(v);
+    const openvdb::Index i = Leaf::coordToOffset(v);
+    l.setValueOn(i, l.getValue(i) + sum);
+  }
+
+  void move_into(PointSumGrid& grid) {
+    for (auto& [origin, leaf] : leaves_) grid.tree().addLeaf(leaf.release());
+    leaves_.clear();
+    last_ = nullptr;
+  }
+
+ private:
+  Leaf& leaf(const openvdb::Coord& v) {
+    const openvdb::Coord origin = leaf_origin_of(v);
+    if (last_ != nullptr && last_->origin() == origin) return *last_;
+    std::unique_ptr<Leaf>& slot = leaves_[origin];
+    if (!slot) slot = std::make_unique<Leaf>(origin, openvdb::Vec4f(0.0f));
+    last_ = slot.get();
+    return *last_;
+  }
+
+  std::unordered_map<openvdb::Coord, std::unique_ptr<Leaf>, CoordHash> leaves_;
+  Leaf* last_ = nullptr;
+};
+
 // Floor of x for |x| < 2^31 without a libm call (positions are bounded to 10 km).
 inline int floor_int(double x) {
   const int i = static_cast<int>(x);
   return x < i ? i - 1 : i;
 }
 
-// Adds the frame's points in range to their local voxels. Neighbouring pixels mostly share a
-// voxel, so a run of points in one voxel is summed first and added to the grid once.
-void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& grid) {
-  auto acc = grid.getAccessor();
-  const double inverse = 1.0 / config.local_voxel;
-  const double min2 = config.min_range * config.min_range, max2 = config.max_range * config.max_range;
-  const Eigen::Matrix3d rotation = frame.world_T_camera.linear();
-  const Eigen::Vector3d translation = frame.world_T_camera.translation();
-  openvdb::Coord run(std::numeric_limits<int>::min());
-  openvdb::Vec4f run_sum(0.0f);
-  auto flush = [&] {
-    if (run_sum[3] > 0.0f) acc.setValue(run, acc.getValue(run) + run_sum);
-  };
-  for (const Eigen::Vector3f& pc : frame.points_camera) {
-    if (!pc.allFinite()) continue;
+// A frame point's world position and local voxel; false for a point not fused (not finite, or
+// out of range).
+class PointBinner {
+ public:
+  PointBinner(const VdbGpdfConfig& config, const Frame& frame)
+      : inverse_(1.0 / config.local_voxel), min2_(config.min_range * config.min_range),
+        max2_(config.max_range * config.max_range), rotation_(frame.world_T_camera.linear()),
+        translation_(frame.world_T_camera.translation()) {}
+
+  bool bin(const Eigen::Vector3f& pc, Eigen::Vector3d& p, openvdb::Coord& v) const {
+    if (!pc.allFinite()) return false;
     const Eigen::Vector3d c = pc.cast<double>();
     const double r2 = c.squaredNorm();
-    if (r2 < min2 || r2 > max2) continue;
-    const Eigen::Vector3d p = rotation * c + translation;
-    const openvdb::Coord v(floor_int(p.x() * inverse), floor_int(p.y() * inverse), floor_int(p.z() * inverse));
-    if (v != run) {
-      flush();
-      run = v;
-      run_sum = openvdb::Vec4f(0.0f);
-    }
-    run_sum += openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f);
+    if (r2 < min2_ || r2 > max2_) return false;
+    p = rotation_ * c + translation_;
+    v = openvdb::Coord(floor_int(p.x() * inverse_), floor_int(p.y() * inverse_), floor_int(p.z() * inverse_));
+    return true;
   }
-  flush();
+
+ private:
+  double inverse_, min2_, max2_;
+  Eigen::Matrix3d rotation_;
+  Eigen::Vector3d translation_;
+};
+
+// Consecutive fused points in one local voxel (neighbouring pixels mostly share one) and their
+// sum, added to the grid at once.
+struct PointRun {
+  openvdb::Coord voxel;
+  openvdb::Vec4f sum;
+};
+
+using RunsPerBucket = std::vector<std::vector<PointRun>>;
+
+// The runs that start among points [begin, end), each summed to its end (past `end` if it goes
+// on: a run belongs whole to the chunk it starts in), sorted into their voxels' buckets.
+void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& points, size_t begin,
+                size_t end, RunsPerBucket& buckets) {
+  Eigen::Vector3d p;
+  openvdb::Coord v, run(std::numeric_limits<int>::min());
+  for (size_t i = begin; i-- > 0;)  // the run going on at `begin`, if any
+    if (binner.bin(points[i], p, run)) break;
+  bool own = false;  // the current run started in this chunk
+  openvdb::Vec4f sum(0.0f);
+  for (size_t i = begin; i < points.size(); ++i) {
+    if (!binner.bin(points[i], p, v)) continue;
+    if (v != run) {
+      if (own) buckets[bucket_of(run)].push_back({run, sum});
+      own = false;
+      if (i >= end) return;
+      run = v;
+      sum = openvdb::Vec4f(0.0f);
+      own = true;
+    }
+    if (own) sum += openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f);
+  }
+  if (own) buckets[bucket_of(run)].push_back({run, sum});
+}
+
+// Adds the frame's points in range to their local voxels: runs found per chunk of points, then
+// added per bucket in the points' order, so each voxel sums its runs as one serial pass would.
+void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& grid) {
+  const PointBinner binner(config, frame);
+  const std::vector<Eigen::Vector3f>& points = frame.points_camera;
+  std::vector<RunsPerBucket> runs(kWorkParts, RunsPerBucket(kWorkParts));  // per chunk
+  parallel_for_each_index(kWorkParts, [&](size_t c) {
+    chunk_runs(binner, points, points.size() * c / kWorkParts, points.size() * (c + 1) / kWorkParts, runs[c]);
+  });
+  std::vector<PointSumLeaves> buckets(kWorkParts);
+  parallel_for_each_index(kWorkParts, [&](size_t b) {
+    for (const RunsPerBucket& chunk : runs)
+      for (const PointRun& r : chunk[b]) buckets[b].add(r.voxel, r.sum);
+  });
+  for (PointSumLeaves& bucket : buckets) bucket.move_into(grid);  // leaves in any order: the same tree
+}
+
+// One local leaf's occupied local voxels (centroid and the global voxel holding it) and the
+// global voxels holding its GP training points.
+struct LeafCells {
+  struct Cell {
+    Eigen::Vector3d centroid;
+    openvdb::Coord global;
+  };
+  std::vector<Cell> cells;
+  std::vector<openvdb::Coord> trained;
+};
+
+// Per local leaf, in parallel: its GP training points (the centroids of every voxel_downsample-th
+// occupied local voxel, not the voxel centres: centres put a face up to half a local voxel inside
+// or outside it), their box, and its cells.
+std::vector<LeafCells> training_points(const VdbGpdfConfig& config, LocalFrame& out) {
+  std::vector<const PointSumGrid::TreeType::LeafNodeType*> leaves;
+  for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
+  const size_t n = leaves.size();
+  LocalGps& gps = out.gps;
+  gps.voxel = config.local_voxel;
+  gps.origins.resize(n);
+  gps.centres.resize(n);
+  gps.bounds.resize(n);
+  out.training.resize(n);
+  std::vector<LeafCells> cells(n);
+  parallel_for_each_index(n, [&](size_t i) {
+    const size_t on = leaves[i]->onVoxelCount();
+    cells[i].cells.reserve(on);
+    cells[i].trained.reserve(on / config.voxel_downsample + 1);
+    out.training[i].reserve(on / config.voxel_downsample + 1);
+    int k = 0;
+    for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
+      const Eigen::Vector3d c = centroid(*v);
+      cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
+      if (k % config.voxel_downsample != 0) continue;
+      out.training[i].push_back(c.cast<float>());
+      cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
+      gps.bounds[i].extend(out.training[i].back().cast<double>());
+    }
+    gps.origins[i] = leaves[i]->origin();
+    gps.centres[i] = leaf_centre(gps.origins[i], config.local_voxel);
+  });
+  for (size_t i = 0; i < n; ++i) gps.index.emplace(gps.origins[i], static_cast<int>(i));
+  gps.link_neighbours();
+  return cells;
+}
+
+// Per global voxel holding a local voxel's centroid: how many it holds, or -1 when it holds a
+// GP training point. (Serial: one pass of cheap adds, the centroids are computed already.)
+void count_cells(const std::vector<LeafCells>& leaves, openvdb::Int32Grid& counts) {
+  auto count = counts.getAccessor();
+  for (const LeafCells& leaf : leaves)
+    for (const auto& cell : leaf.cells) count.setValue(cell.global, count.getValue(cell.global) + 1);
+  for (const LeafCells& leaf : leaves)
+    for (const openvdb::Coord& g : leaf.trained)
+      if (count.isValueOn(g)) count.setValue(g, -1);
+}
+
+// The global voxels holding one of the frame's points (their local voxels' centroids) and their
+// 26 neighbours. A ray proves free only the space it crosses, and the centre of a voxel it
+// crosses can lie up to 0.87 voxel off it, so next to a surface that centre can be behind the
+// surface. Rays grazing past a silhouette edge, a corner or a thin top carved the object's own
+// inside, hundreds of rays against one or two surface samples, and the circle lost the edge
+// (room, 300 frames: 69 bin readings too far by over 0.1 m, TSDF peer 15). In these voxels a
+// free-space value needs the depth image's word that the centre is free (DepthView).
+// (Serial, beside count_cells: a threaded dilation of this small mask was slower.)
+void near_surface(const std::vector<LeafCells>& leaves, openvdb::MaskGrid& mask) {
+  auto acc = mask.getAccessor();
+  for (const LeafCells& leaf : leaves)
+    for (const auto& cell : leaf.cells) acc.setValueOn(cell.global);
+  openvdb::tools::dilateActiveValues(mask.tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                     openvdb::tools::IGNORE_TILES, false);
+}
+
+// The sources: per local leaf its training points, then the first centroid (in leaf order)
+// of every global voxel without a training point that holds kMinSparseCells local voxels or
+// more, or lies at the image's edge. Candidates are found per leaf in parallel, then taken in
+// leaf order (marking their global voxel -1 in `counts`).
+void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& leaves,
+                        openvdb::Int32Grid& counts, LocalFrame& local) {
+  std::vector<std::vector<const LeafCells::Cell*>> candidates(leaves.size());
+  local.sources.resize(leaves.size());
+  parallel_for_each_index(leaves.size(), [&](size_t i) {
+    local.sources[i] = local.training[i];
+    const auto count = counts.getConstAccessor();
+    for (const auto& cell : leaves[i].cells) {
+      const int held = count.getValue(cell.global);
+      if (held >= kMinSparseCells || (held >= 1 && view.at_edge(cell.centroid, kEdgePixels)))
+        candidates[i].push_back(&cell);
+    }
+  });
+  auto count = counts.getAccessor();
+  for (size_t i = 0; i < leaves.size(); ++i)
+    for (const LeafCells::Cell* cell : candidates[i]) {
+      if (count.getValue(cell->global) < 1) continue;  // taken by an earlier candidate
+      count.setValue(cell->global, -1);
+      local.sources[i].push_back(cell->centroid.cast<float>());
+    }
 }
 
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
-  out.gps.voxel = config.local_voxel;
-  for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) {
-    std::vector<Eigen::Vector3f> pts;
-    int i = 0;
-    for (auto v = leaf->cbeginValueOn(); v; ++v, ++i)
-      if (i % config.voxel_downsample == 0) pts.push_back(centroid(*v).cast<float>());
-    out.gps.index.emplace(leaf->origin(), static_cast<int>(out.gps.origins.size()));
-    out.gps.origins.push_back(leaf->origin());
-    out.gps.centres.push_back(leaf_centre(leaf->origin(), config.local_voxel));
-    Eigen::AlignedBox3d box;
-    for (const auto& p : pts) box.extend(p.cast<double>());
-    out.gps.bounds.push_back(box);
-    out.training.push_back(std::move(pts));
-  }
-  out.gps.link_neighbours();
-  near_surface(out.points, config.global_voxel, out.near);
-  add_sparse_sources(config.global_voxel, view, out);
+  const std::vector<LeafCells> cells = training_points(config, out);
+  openvdb::Int32Grid counts(0);
+  parallel_both([&] { count_cells(cells, counts); }, [&] { near_surface(cells, out.near); });
+  add_sparse_sources(view, cells, counts, out);
 }
 
 // Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
