@@ -412,10 +412,11 @@ struct LeafCells {
   std::vector<openvdb::Coord> trained;
 };
 
-// Per local leaf, in parallel: its GP training points (the centroids of every voxel_downsample-th
-// occupied local voxel, not the voxel centres: centres put a face up to half a local voxel inside
-// or outside it), their box, and its cells.
-std::vector<LeafCells> training_points(const VdbGpdfConfig& config, LocalFrame& out) {
+// The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
+// centroids of every voxel_downsample-th occupied local voxel, not the voxel centres: centres put
+// a face up to half a local voxel inside or outside it), their box, and its cells; then the leaf
+// index and the neighbour links.
+std::vector<LeafCells> index_local_leaves(const VdbGpdfConfig& config, LocalFrame& out) {
   std::vector<const PointSumGrid::TreeType::LeafNodeType*> leaves;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   const size_t n = leaves.size();
@@ -503,7 +504,7 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
 
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
-  const std::vector<LeafCells> cells = training_points(config, out);
+  const std::vector<LeafCells> cells = index_local_leaves(config, out);
   openvdb::Int32Grid counts(0);
   parallel_both([&] { count_cells(cells, counts); }, [&] { near_surface(cells, out.near); });
   add_sparse_sources(view, cells, counts, out);
