@@ -28,6 +28,7 @@ std::vector<SurfaceMesh> FusedGrid::refresh(const std::vector<openvdb::Coord>& l
 
 void FusedGrid::surface_points(const Eigen::Vector3d& center, double radius,
                                std::vector<Eigen::Vector3f>& out) const {
+  out.clear();
   cache_.collect(center, radius, out);
 }
 

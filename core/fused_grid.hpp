@@ -35,7 +35,8 @@ class FusedGrid {
   // Re-marches the given leaves (in parallel) and replaces their surface samples; returns
   // each leaf's mesh (empty where the leaf holds no surface).
   std::vector<SurfaceMesh> refresh(const std::vector<openvdb::Coord>& leaves);
-  // Surface samples within horizontal distance `radius` of center, at most half a voxel apart.
+  // Replaces `out` with the surface samples within horizontal distance `radius` of center, at
+  // most half a voxel apart (the Mapper contract of both maps that fuse into this grid).
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const;
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,

@@ -269,7 +269,6 @@ std::vector<LeafChanges> Tsdf::integrate_rays(const Frame& frame) {
 
 void Tsdf::surface_points(const Eigen::Vector3d& center, double radius,
                           std::vector<Eigen::Vector3f>& out) const {
-  out.clear();
   fused_.surface_points(center, radius, out);
 }
 

@@ -840,7 +840,6 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
 
 void VdbGpdf::surface_points(const Eigen::Vector3d& center, double radius,
                              std::vector<Eigen::Vector3f>& out) const {
-  out.clear();
   fused_.surface_points(center, radius, out);
 }
 
