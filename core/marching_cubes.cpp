@@ -169,13 +169,26 @@ void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::
     count += static_cast<size_t>(n + 1) * (n + 2) / 2;
   }
   out.reserve(out.size() + count);  // one allocation instead of a growing vector's many
+  // About six triangles share a vertex and each would emit it as a corner, half of all
+  // samples. A corner that computes to its vertex exactly is emitted the first time only: a
+  // repeat never changes a raster, whose cells keep the first point met at equal range.
+  std::vector<bool> vertex_emitted(mesh.vertices.size(), false);
+  auto emit = [&](const Eigen::Vector3f& p, int corner_vertex) {
+    if (corner_vertex >= 0 && p == mesh.vertices[corner_vertex]) {
+      if (vertex_emitted[corner_vertex]) return;
+      vertex_emitted[corner_vertex] = true;
+    }
+    out.push_back(p);
+  };
   for (size_t k = 0; k < mesh.triangles.size(); ++k) {
     const Eigen::Vector3i& t = mesh.triangles[k];
     const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
     const int n = divisions[k];
     for (int i = 0; i <= n; ++i)
-      for (int j = 0; j <= n - i; ++j)
-        out.push_back(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n));
+      for (int j = 0; j <= n - i; ++j) {
+        const int corner = i == 0 ? (j == 0 ? t[0] : j == n ? t[2] : -1) : (i == n ? t[1] : -1);
+        emit(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n), corner);
+      }
   }
 }
 
@@ -219,7 +232,13 @@ void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vec
     min_z_ = std::min(min_z_, leaf_origin.z());
     max_z_ = std::max(max_z_, leaf_origin.z());
   }
-  leaves_[leaf_origin] = std::move(samples);
+  LeafSamples& leaf = leaves_[leaf_origin];
+  leaf.min_xy = leaf.max_xy = samples.front().head<2>();
+  for (const Eigen::Vector3f& p : samples) {
+    leaf.min_xy = leaf.min_xy.cwiseMin(p.head<2>());
+    leaf.max_xy = leaf.max_xy.cwiseMax(p.head<2>());
+  }
+  leaf.points = std::move(samples);
 }
 
 void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
@@ -230,21 +249,33 @@ void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
   const int y0 = static_cast<int>(std::floor((center.y() - radius) / leaf_size_)) * kLeafDim;
   const int y1 = static_cast<int>(std::floor((center.y() + radius) / leaf_size_)) * kLeafDim;
   const double r2 = radius * radius;
+  auto within = [&](const Eigen::Vector2f& p) {
+    const double dx = p.x() - center.x(), dy = p.y() - center.y();
+    return dx * dx + dy * dy <= r2;
+  };
+  auto farther = [](float lo, float hi, double c) { return std::abs(lo - c) > std::abs(hi - c) ? lo : hi; };
   for (int x = x0; x <= x1; x += kLeafDim)
     for (int y = y0; y <= y1; y += kLeafDim)
       for (int z = min_z_; z <= max_z_; z += kLeafDim) {
         const auto it = leaves_.find(openvdb::Coord(x, y, z));
         if (it == leaves_.end()) continue;
-        for (const auto& p : it->second) {
-          const double dx = p.x() - center.x(), dy = p.y() - center.y();
-          if (dx * dx + dy * dy <= r2) out.push_back(p);
+        const LeafSamples& leaf = it->second;
+        // within() rounds monotonically in each coordinate: when the farthest corner of the
+        // leaf's bounds is within, every sample is. Copy them all.
+        const Eigen::Vector2f far_corner(farther(leaf.min_xy.x(), leaf.max_xy.x(), center.x()),
+                                         farther(leaf.min_xy.y(), leaf.max_xy.y(), center.y()));
+        if (within(far_corner)) {
+          out.insert(out.end(), leaf.points.begin(), leaf.points.end());
+          continue;
         }
+        for (const auto& p : leaf.points)
+          if (within(p.head<2>())) out.push_back(p);
       }
 }
 
 size_t SurfaceCache::sample_count() const {
   size_t n = 0;
-  for (const auto& kv : leaves_) n += kv.second.size();
+  for (const auto& kv : leaves_) n += kv.second.points.size();
   return n;
 }
 

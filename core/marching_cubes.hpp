@@ -63,7 +63,7 @@ SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float 
 
 // Points on the triangles themselves, so that neighbouring samples are at most `spacing`
 // apart along every edge: each triangle is subdivided into n^2 sub-triangles with
-// n = ceil(longest edge / spacing) and all their corners are emitted.
+// n = ceil(longest edge / spacing) and all their corners are appended, a mesh vertex once.
 void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out);
 
 // The voxels of one leaf (origin, one bit per voxel in the leaf's own order) that changed.
@@ -95,8 +95,12 @@ class SurfaceCache {
   void clear() { leaves_.clear(); }
 
  private:
+  struct LeafSamples {
+    std::vector<Eigen::Vector3f> points;
+    Eigen::Vector2f min_xy, max_xy;  // their horizontal bounds
+  };
   double leaf_size_;  // world size of one leaf (8 voxels)
-  std::unordered_map<openvdb::Coord, std::vector<Eigen::Vector3f>, CoordHash> leaves_;
+  std::unordered_map<openvdb::Coord, LeafSamples, CoordHash> leaves_;
   int min_z_ = 0, max_z_ = -1;  // range of leaf origins' z (index space) seen so far
 };
 
