@@ -32,27 +32,42 @@ class Rasteriser {
   // on an edge always belongs to the bin above it (and 359.9999999999 wraps to bin 0).
   // The cylinder row is floor((z - ground_z - band_min) / row_height); the band's top edge
   // belongs to the last row, heights above the last row's top only reach the circle.
-  void add(const Eigen::Vector3f& point);
+  void add(const Eigen::Vector3f& point) { add_to(cells_, point); }
+  // The same as adding the points one by one in order, split into fixed parts (so the result
+  // does not depend on the thread count) rasterised in parallel and merged in order.
   void add(const Eigen::Vector3f* points, std::size_t count);
   void add(const std::vector<Eigen::Vector3f>& points) { add(points.data(), points.size()); }
 
-  const Circle& circle() const { return circle_; }
-  const Cylinder& cylinder() const { return cylinder_; }
+  const Circle& circle() const { return cells_.circle; }
+  const Cylinder& cylinder() const { return cells_.cylinder; }
   const RasterConfig& config() const { return config_; }
   const RasterOrigin& origin() const { return origin_; }
 
  private:
   // The bin of body-frame direction (x ahead, y left), as floor(atan2(y, x) / bin width) with
   // the edge snapping described at add().
+  struct Cells {
+    Circle circle;
+    Cylinder cylinder;
+    void clear();
+    // Takes each of `part`'s cells that is nearer (strictly: at equal range the cell keeps
+    // its point, which came first).
+    void merge(const Cells& part);
+  };
+  void add_to(Cells& cells, const Eigen::Vector3f& point) const;
   int bin_of(double x, double y) const;
+  // The cylinder row of a height in the band (rows when above the last row).
+  int row_of(double height) const;
 
   RasterConfig config_;
   RasterOrigin origin_;
   double cos_heading_ = 1.0;
   double sin_heading_ = 0.0;
   double max_range2_ = 0.0;
-  Circle circle_;
-  Cylinder cylinder_;
+  double bins_per_radian_ = 1.0;   // bins per radian of azimuth
+  double fast_margin_bins_ = 0.0;  // the fast atan2's error bound, in bins
+  Cells cells_;
+  std::vector<Cells> parts_;  // scratch of add(points, count)
 };
 
 }  // namespace sonomap

@@ -161,6 +161,35 @@ TEST_CASE("Each cell keeps the closest point, the cylinder keeps it per row", "[
   CHECK(r.cylinder().known_count() == 2);
 }
 
+TEST_CASE("Of points at equal range in one cell the first added stays, also among many added at once",
+          "[rasteriser]") {
+  // 40 000 points on a 4 m ring at 1.05 m (row 9), then in bin 30 three pairs at 2.5 m:
+  // equal horizontal range, heights 1.01 and 1.09 in one row, the pairs far apart in the list.
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 40000; ++i) points.push_back(polar(360.0 * (i + 0.5) / 40000.0, 4.0, 1.05));
+  const Eigen::Vector3f first = polar(30.5, 2.5, 1.01), second = polar(30.5, 2.5, 1.09);
+  points[100] = first;
+  points[39000] = second;
+  points[20000] = second;
+  points[30000] = first;
+  const Eigen::Vector3f nearer = polar(40.5, 2.0, 1.09), farther_first = polar(40.5, 2.2, 1.01);
+  points[50] = farther_first;
+  points[35000] = nearer;
+
+  Rasteriser at_once = at_origin(), one_by_one = at_origin();
+  at_once.add(points);
+  for (const Eigen::Vector3f& p : points) one_by_one.add(p);
+  for (const Rasteriser* r : {&at_once, &one_by_one}) {
+    CHECK(r->circle().bins[30].range == Approx(2.5).epsilon(1e-6));
+    CHECK(r->circle().bins[30].point == first);
+    CHECK(r->cylinder().at(9, 30).point == first);
+    CHECK(r->circle().bins[40].point == nearer);
+    CHECK(r->cylinder().at(9, 40).point == nearer);
+    CHECK(r->circle().bins[200].range == Approx(4.0).epsilon(1e-6));
+    CHECK(r->cylinder().known_count() == 360);
+  }
+}
+
 TEST_CASE("reset starts an empty raster around the new origin", "[rasteriser]") {
   Rasteriser r = at_origin();
   r.add(Eigen::Vector3f(2.0f, 0.0f, 1.0f));
