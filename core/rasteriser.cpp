@@ -3,7 +3,9 @@
 
 #include "core/parallel.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 namespace sonomap {
@@ -14,22 +16,58 @@ constexpr double kDegreesPerRadian = 180.0 / M_PI;
 constexpr double kAxisRange = 1e-9;      // metres: closer to the vertical axis has no azimuth
 constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at bin edges
 
-// atan2(y, x) within kFastAtanErrorDeg, without a libm call (Abramowitz and Stegun 4.4.47 on
-// [0, 1], |error| <= 1e-5 rad, then the octant). Most points then need no exact atan2: only
-// one that lands this close to a bin edge is binned again the exact way, so the bins are
-// exactly those of atan2 (a frame's 80 thousand surface samples cost 4 ms of atan2).
+// The first pass over a batch of points finds, for each, whether it counts, its squared range,
+// its bin position by a fast arctangent and its row quotient. It is written without branches,
+// over arrays of one type, so that the compiler vectorises it (an AVX2 clone is chosen at run
+// time on x86-64; CMakeLists.txt says why this file needs -fno-trapping-math). The second
+// pass, one point at a time, places the points in their cells.
+constexpr size_t kBatch = 256;
+
+struct Batch {
+  double x[kBatch], y[kBatch], z[kBatch];  // the points, in the world
+  double range2[kBatch];                   // squared horizontal range
+  double bin_position[kBatch];             // fast atan2 / bin width, in [0, bins]
+  double row_position[kBatch];             // (height - band_min) / row height
+  int64_t counts[kBatch];                  // in the band and the range (0 if not finite)
+  int64_t near_edge[kBatch];               // within the fast arctangent's error of a bin edge
+};
+
+// The fast arctangent is Abramowitz and Stegun 4.4.47 on [0, 1], |error| <= 1e-5 rad, then
+// the octant, without a libm call. Only a point that lands this close to a bin edge is
+// binned again the exact way, so the bins are exactly those of atan2.
 constexpr double kFastAtanErrorDeg = 2e-3;  // the polynomial's 5.7e-4 degrees, with room
 
-double fast_atan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  const bool steep = ay > ax;
-  const double t = steep ? ax / ay : ay / ax;  // in [0, 1]
-  const double t2 = t * t;
-  double a = t * (0.9998660 + t2 * (-0.3302995 + t2 * (0.1801410 + t2 * (-0.0851330 + t2 * 0.0208351))));
-  if (steep) a = M_PI / 2 - a;
-  if (x < 0.0) a = M_PI - a;
-  if (y < 0.0) a = -a;
-  return a;
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
+  const Rasteriser::Placement at = placement;  // locals: a load inside a select could trap
+  for (size_t i = 0; i < n; ++i) {
+    const double height = b.z[i] - at.ground_z;
+    const double dx = b.x[i] - at.x, dy = b.y[i] - at.y;
+    const double range2 = dx * dx + dy * dy;
+    // NaN fails every comparison, so non-finite points do not count.
+    b.counts[i] = (height >= at.band_min) & (height <= at.band_max) & (range2 <= at.max_range2) &
+                  (range2 >= kAxisRange * kAxisRange);
+    // Rotate the offset by -heading into the body frame (x ahead, y left).
+    const double x = at.cos_heading * dx + at.sin_heading * dy;
+    const double y = -at.sin_heading * dx + at.cos_heading * dy;
+    const double ax = std::abs(x), ay = std::abs(y);
+    const bool steep = ay > ax;
+    const double t = (steep ? ax : ay) / (steep ? ay : ax);  // in [0, 1]
+    const double t2 = t * t;
+    const double a0 = t * (0.9998660 + t2 * (-0.3302995 + t2 * (0.1801410 + t2 * (-0.0851330 + t2 * 0.0208351))));
+    const double a1 = steep ? M_PI / 2 - a0 : a0;
+    const double a2 = x < 0.0 ? M_PI - a1 : a1;
+    const double a3 = y < 0.0 ? -a2 : a2;
+    const double signed_position = a3 * at.bins_per_radian, wrapped = signed_position + at.bins;
+    const double position = signed_position < 0.0 ? wrapped : signed_position;
+    const double above_edge = position - std::floor(position);
+    b.range2[i] = range2;
+    b.bin_position[i] = position;
+    b.row_position[i] = (height - at.band_min) / at.row_height;
+    b.near_edge[i] = (above_edge <= at.margin_bins) | (above_edge >= 1.0 - at.margin_bins);
+  }
 }
 
 // Whether a sample at squared range `range2` may be nearer than what `cell` holds. The cell
@@ -45,9 +83,13 @@ bool may_be_nearer(double range2, const RasterCell& cell) {
 
 Rasteriser::Rasteriser(const RasterConfig& config) : config_(config) {
   config_.validate();
-  max_range2_ = config_.max_range * config_.max_range;
-  bins_per_radian_ = kDegreesPerRadian / config_.bin_width_deg();
-  fast_margin_bins_ = kFastAtanErrorDeg / config_.bin_width_deg();
+  at_.band_min = config_.band_min;
+  at_.band_max = config_.band_max;
+  at_.max_range2 = config_.max_range * config_.max_range;
+  at_.bins = config_.azimuth_bins;
+  at_.bins_per_radian = kDegreesPerRadian / config_.bin_width_deg();
+  at_.margin_bins = kFastAtanErrorDeg / config_.bin_width_deg();
+  at_.row_height = config_.row_height;
   cells_ = Cells{make_circle(config_), make_cylinder(config_)};
 }
 
@@ -57,26 +99,15 @@ void Rasteriser::reset(const RasterOrigin& origin) {
     throw std::invalid_argument("Rasteriser::reset: raster origin is not finite");
   }
   origin_ = origin;
-  cos_heading_ = std::cos(origin.heading);
-  sin_heading_ = std::sin(origin.heading);
+  at_.x = origin.position.x();
+  at_.y = origin.position.y();
+  at_.ground_z = origin.ground_z;
+  at_.cos_heading = std::cos(origin.heading);
+  at_.sin_heading = std::sin(origin.heading);
   cells_.clear();
 }
 
-void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f& point) const {
-  if (!point.allFinite()) return;
-  const double height = static_cast<double>(point.z()) - origin_.ground_z;
-  if (!(height >= config_.band_min && height <= config_.band_max)) return;
-
-  const double dx = static_cast<double>(point.x()) - origin_.position.x();
-  const double dy = static_cast<double>(point.y()) - origin_.position.y();
-  const double range2 = dx * dx + dy * dy;
-  if (range2 > max_range2_ || range2 < kAxisRange * kAxisRange) return;
-
-  // Rotate the offset by -heading into the body frame (x ahead, y left).
-  const double x = cos_heading_ * dx + sin_heading_ * dy;
-  const double y = -sin_heading_ * dx + cos_heading_ * dy;
-  const int bin = bin_of(x, y);
-  const int row = row_of(height);
+inline void Rasteriser::place(Cells& cells, const Eigen::Vector3f& point, double range2, int bin, int row) {
   RasterCell& cell = cells.circle.bins[static_cast<size_t>(bin)];
   RasterCell* cyl_cell = row < cells.cylinder.rows ? &cells.cylinder.at(row, bin) : nullptr;
   // The circle's cell is never farther than a cylinder cell of its bin, so a sample that
@@ -88,22 +119,41 @@ void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f& point) const {
   if (cyl_cell && range < cyl_cell->range) *cyl_cell = RasterCell{range, point};
 }
 
-int Rasteriser::row_of(double height) const {
-  // floor() of a non-negative quotient (the height is in the band): truncation, no libm call.
-  const int row = static_cast<int>((height - config_.band_min) / config_.row_height);
+inline int Rasteriser::last_row_fix(int row, const Eigen::Vector3f& point) const {
   // The top edge of the last row is inside it (the band is closed); rounding of the
   // division must not push it out.
   const int rows = cells_.cylinder.rows;
-  if (row == rows && height <= config_.row_top(rows - 1) + 1e-9) return rows - 1;
+  if (row == rows && static_cast<double>(point.z()) - at_.ground_z <= config_.row_top(rows - 1) + 1e-9) {
+    return rows - 1;
+  }
   return row;
 }
 
-int Rasteriser::bin_of(double x, double y) const {
-  double fast = fast_atan2(y, x) * bins_per_radian_;
-  if (fast < 0.0) fast += config_.azimuth_bins;
-  const int below = static_cast<int>(fast);  // floor: fast >= 0
-  const double above_edge = fast - below;
-  if (above_edge > fast_margin_bins_ && above_edge < 1.0 - fast_margin_bins_) return below;
+void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t count) const {
+  Batch b;
+  for (size_t begin = 0; begin < count; begin += kBatch) {
+    const size_t n = std::min(kBatch, count - begin);
+    for (size_t k = 0; k < n; ++k) {
+      b.x[k] = points[begin + k].x();
+      b.y[k] = points[begin + k].y();
+      b.z[k] = points[begin + k].z();
+    }
+    locate(n, at_, b);
+    for (size_t k = 0; k < n; ++k) {
+      if (!b.counts[k]) continue;
+      const Eigen::Vector3f& point = points[begin + k];
+      // Both positions are in range for a point that counts: the conversions are floors.
+      const int bin = b.near_edge[k] ? exact_bin(point) : static_cast<int>(b.bin_position[k]);
+      place(cells, point, b.range2[k], bin, last_row_fix(static_cast<int>(b.row_position[k]), point));
+    }
+  }
+}
+
+int Rasteriser::exact_bin(const Eigen::Vector3f& point) const {
+  const double dx = static_cast<double>(point.x()) - at_.x;
+  const double dy = static_cast<double>(point.y()) - at_.y;
+  const double x = at_.cos_heading * dx + at_.sin_heading * dy;
+  const double y = -at_.sin_heading * dx + at_.cos_heading * dy;
   const double width = config_.bin_width_deg();
   double bin_position = std::atan2(y, x) * kDegreesPerRadian / width;
   if (bin_position < 0.0) bin_position += config_.azimuth_bins;
@@ -136,14 +186,15 @@ void Rasteriser::add(const Eigen::Vector3f* points, std::size_t count) {
   // first of those: the same point. The parts depend on the count alone.
   constexpr size_t kParts = 4, kMinPartPoints = 4096;
   if (count < kParts * kMinPartPoints) {
-    for (std::size_t i = 0; i < count; ++i) add_to(cells_, points[i]);
+    add_to(cells_, points, count);
     return;
   }
   parts_.resize(kParts, cells_);
   parallel_for_each_index(kParts, [&](size_t part) {
     Cells& cells = parts_[part];
     cells.clear();
-    for (size_t i = part * count / kParts; i < (part + 1) * count / kParts; ++i) add_to(cells, points[i]);
+    const size_t begin = part * count / kParts, end = (part + 1) * count / kParts;
+    add_to(cells, points + begin, end - begin);
   });
   for (const Cells& part : parts_) cells_.merge(part);
 }

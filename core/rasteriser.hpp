@@ -32,7 +32,7 @@ class Rasteriser {
   // on an edge always belongs to the bin above it (and 359.9999999999 wraps to bin 0).
   // The cylinder row is floor((z - ground_z - band_min) / row_height); the band's top edge
   // belongs to the last row, heights above the last row's top only reach the circle.
-  void add(const Eigen::Vector3f& point) { add_to(cells_, point); }
+  void add(const Eigen::Vector3f& point) { add_to(cells_, &point, 1); }
   // The same as adding the points one by one in order, split into fixed parts (so the result
   // does not depend on the thread count) rasterised in parallel and merged in order.
   void add(const Eigen::Vector3f* points, std::size_t count);
@@ -43,9 +43,15 @@ class Rasteriser {
   const RasterConfig& config() const { return config_; }
   const RasterOrigin& origin() const { return origin_; }
 
+ // What the per-point pass needs of the config and the origin, as plain numbers.
+  struct Placement {
+    double x = 0.0, y = 0.0, ground_z = 0.0, cos_heading = 1.0, sin_heading = 0.0;
+    double band_min = 0.0, band_max = 0.0, max_range2 = 0.0, row_height = 1.0;
+    double bins = 1.0, bins_per_radian = 1.0;
+    double margin_bins = 0.0;  // the fast arctangent's error bound, in bins
+  };
+
  private:
-  // The bin of body-frame direction (x ahead, y left), as floor(atan2(y, x) / bin width) with
-  // the edge snapping described at add().
   struct Cells {
     Circle circle;
     Cylinder cylinder;
@@ -54,18 +60,18 @@ class Rasteriser {
     // its point, which came first).
     void merge(const Cells& part);
   };
-  void add_to(Cells& cells, const Eigen::Vector3f& point) const;
-  int bin_of(double x, double y) const;
-  // The cylinder row of a height in the band (rows when above the last row).
-  int row_of(double height) const;
+  void add_to(Cells& cells, const Eigen::Vector3f* points, std::size_t count) const;
+  // Puts a counting point in the circle's cell and the cylinder's (row < rows) where nearer.
+  static void place(Cells& cells, const Eigen::Vector3f& point, double range2, int bin, int row);
+  // The bin of a point as floor(atan2(y, x) / bin width) in the body frame (x ahead, y left),
+  // with the edge snapping described at add().
+  int exact_bin(const Eigen::Vector3f& point) const;
+  // The row from the quotient's floor, the band's top edge kept in the last row.
+  int last_row_fix(int row, const Eigen::Vector3f& point) const;
 
   RasterConfig config_;
   RasterOrigin origin_;
-  double cos_heading_ = 1.0;
-  double sin_heading_ = 0.0;
-  double max_range2_ = 0.0;
-  double bins_per_radian_ = 1.0;   // bins per radian of azimuth
-  double fast_margin_bins_ = 0.0;  // the fast atan2's error bound, in bins
+  Placement at_;
   Cells cells_;
   std::vector<Cells> parts_;  // scratch of add(points, count)
 };
