@@ -230,15 +230,16 @@ TEST_CASE("Every direction lands in the bin floor(atan2 / bin width) gives, also
     RasterConfig config;
     config.azimuth_bins = bins;
     Rasteriser r = at_origin(config);
-    for (double azimuth : azimuths) {
+    // One point alone, and 8 copies at once (the batch pass's vector lanes, not its tail).
+    for (double azimuth : azimuths) for (size_t copies : {1, 8}) {
       r.reset(RasterOrigin{});
       const Eigen::Vector3f p = polar(azimuth, 3.0, 1.0);
-      r.add(p);
+      r.add(std::vector<Eigen::Vector3f>(copies, p));
       const double deg = std::atan2(static_cast<double>(p.y()), static_cast<double>(p.x())) / kDeg;
       const double position = (deg < 0.0 ? deg + 360.0 : deg) / (360.0 / bins);
       const int expected = static_cast<int>(std::floor(position)) % bins;
       if (std::abs(position - std::round(position)) < 1e-8) continue;  // the edge rule has its own test
-      INFO("azimuth " << azimuth << ", " << bins << " bins");
+      INFO("azimuth " << azimuth << ", " << bins << " bins, " << copies << " copies");
       REQUIRE(known_bins(r.circle()) == std::vector<int>{expected});
     }
   }
