@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Builds the circle and the cylinder (docs/conventions.md) from world points around a RasterOrigin.
 // One accumulator reused frame after frame: reset() clears the cells, add() is O(1) per point
-// and never allocates, so a raster from N points costs O(N + cells).
+// and allocates only its parallel scratch, once, so a raster from N points costs O(N + cells).
 #pragma once
 
 #include "core/raster.hpp"
