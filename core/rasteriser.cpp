@@ -37,6 +37,12 @@ struct Batch {
 // binned again the exact way, so the bins are exactly those of atan2.
 constexpr double kFastAtanErrorDeg = 2e-3;  // the polynomial's 5.7e-4 degrees, with room
 
+// The horizontal offset (dx, dy) rotated by -heading into the body frame (x ahead, y left).
+inline void to_body(const Rasteriser::Placement& at, double dx, double dy, double& x, double& y) {
+  x = at.cos_heading * dx + at.sin_heading * dy;
+  y = -at.sin_heading * dx + at.cos_heading * dy;
+}
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx2", "default")))
 #endif
@@ -49,9 +55,8 @@ void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
     // NaN fails every comparison, so non-finite points do not count.
     b.counts[i] = (height >= at.band_min) & (height <= at.band_max) & (range2 <= at.max_range2) &
                   (range2 >= kAxisRange * kAxisRange);
-    // Rotate the offset by -heading into the body frame (x ahead, y left).
-    const double x = at.cos_heading * dx + at.sin_heading * dy;
-    const double y = -at.sin_heading * dx + at.cos_heading * dy;
+    double x, y;
+    to_body(at, dx, dy, x, y);
     const double ax = std::abs(x), ay = std::abs(y);
     const bool steep = ay > ax;
     const double t = (steep ? ax : ay) / (steep ? ay : ax);  // in [0, 1]
@@ -152,8 +157,8 @@ void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t coun
 int Rasteriser::exact_bin(const Eigen::Vector3f& point) const {
   const double dx = static_cast<double>(point.x()) - at_.x;
   const double dy = static_cast<double>(point.y()) - at_.y;
-  const double x = at_.cos_heading * dx + at_.sin_heading * dy;
-  const double y = -at_.sin_heading * dx + at_.cos_heading * dy;
+  double x, y;
+  to_body(at_, dx, dy, x, y);
   const double width = config_.bin_width_deg();
   double bin_position = std::atan2(y, x) * kDegreesPerRadian / width;
   if (bin_position < 0.0) bin_position += config_.azimuth_bins;
