@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "core/parallel.hpp"
+#include "core/point_binning.hpp"
 #include "core/pixel.hpp"
 #include "core/stopwatch.hpp"
 
@@ -319,37 +320,6 @@ class PointSumLeaves {
   Leaf* last_ = nullptr;
 };
 
-// Floor of x for |x| < 2^31 without a libm call (positions are bounded to 10 km).
-inline int floor_int(double x) {
-  const int i = static_cast<int>(x);
-  return x < i ? i - 1 : i;
-}
-
-// A frame point's world position and local voxel; false for a point not fused (not finite, or
-// out of range).
-class PointBinner {
- public:
-  PointBinner(const VdbGpdfConfig& config, const Frame& frame)
-      : inverse_(1.0 / config.local_voxel), min2_(config.min_range * config.min_range),
-        max2_(config.max_range * config.max_range), rotation_(frame.world_T_camera.linear()),
-        translation_(frame.world_T_camera.translation()) {}
-
-  bool bin(const Eigen::Vector3f& pc, Eigen::Vector3d& p, openvdb::Coord& v) const {
-    if (!pc.allFinite()) return false;
-    const Eigen::Vector3d c = pc.cast<double>();
-    const double r2 = c.squaredNorm();
-    if (r2 < min2_ || r2 > max2_) return false;
-    p = rotation_ * c + translation_;
-    v = openvdb::Coord(floor_int(p.x() * inverse_), floor_int(p.y() * inverse_), floor_int(p.z() * inverse_));
-    return true;
-  }
-
- private:
-  double inverse_, min2_, max2_;
-  Eigen::Matrix3d rotation_;
-  Eigen::Vector3d translation_;
-};
-
 // Consecutive fused points in one local voxel (neighbouring pixels mostly share one) and their
 // sum, added to the grid at once.
 struct PointRun {
@@ -363,23 +333,33 @@ using RunsPerBucket = std::vector<std::vector<PointRun>>;
 // on: a run belongs whole to the chunk it starts in), sorted into their voxels' buckets.
 void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& points, size_t begin,
                 size_t end, RunsPerBucket& buckets) {
-  Eigen::Vector3d p;
-  openvdb::Coord v, run(std::numeric_limits<int>::min());
-  for (size_t i = begin; i-- > 0;)  // the run going on at `begin`, if any
-    if (binner.bin(points[i], p, run)) break;
+  PointBinner::Batch b;
+  openvdb::Coord run(std::numeric_limits<int>::min());
+  for (size_t i = begin; i-- > 0;) {  // the run going on at `begin`, if any
+    binner.bin(&points[i], 1, b);
+    if (b.fused[0] != 0.0) {
+      run = b.voxel(0);
+      break;
+    }
+  }
   bool own = false;  // the current run started in this chunk
   openvdb::Vec4f sum(0.0f);
-  for (size_t i = begin; i < points.size(); ++i) {
-    if (!binner.bin(points[i], p, v)) continue;
-    if (v != run) {
-      if (own) buckets[bucket_of(run)].push_back({run, sum});
-      own = false;
-      if (i >= end) return;
-      run = v;
-      sum = openvdb::Vec4f(0.0f);
-      own = true;
+  for (size_t first = begin; first < points.size(); first += PointBinner::kBatch) {
+    const size_t n = std::min(PointBinner::kBatch, points.size() - first);
+    binner.bin(&points[first], n, b);
+    for (size_t k = 0; k < n; ++k) {
+      if (b.fused[k] == 0.0) continue;
+      const openvdb::Coord v = b.voxel(k);
+      if (v != run) {
+        if (own) buckets[bucket_of(run)].push_back({run, sum});
+        own = false;
+        if (first + k >= end) return;
+        run = v;
+        sum = openvdb::Vec4f(0.0f);
+        own = true;
+      }
+      if (own) sum += openvdb::Vec4f(b.x[k], b.y[k], b.z[k], 1.0f);
     }
-    if (own) sum += openvdb::Vec4f(p.x(), p.y(), p.z(), 1.0f);
   }
   if (own) buckets[bucket_of(run)].push_back({run, sum});
 }
@@ -387,7 +367,7 @@ void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& p
 // Adds the frame's points in range to their local voxels: runs found per chunk of points, then
 // added per bucket in the points' order, so each voxel sums its runs as one serial pass would.
 void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& grid) {
-  const PointBinner binner(config, frame);
+  const PointBinner binner(config.local_voxel, config.min_range, config.max_range, frame.world_T_camera);
   const std::vector<Eigen::Vector3f>& points = frame.points_camera;
   std::vector<RunsPerBucket> runs(kWorkParts, RunsPerBucket(kWorkParts));  // per chunk
   parallel_for_each_index(kWorkParts, [&](size_t c) {

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "core/point_binning.hpp"
+
+#include <cmath>
+
+namespace sonomap {
+
+namespace {
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+  const PointBinner::Pose at = pose;  // locals: a load inside a select could trap (see core/CMakeLists.txt)
+  for (size_t i = 0; i < n; ++i) {
+    const double cx = b.cx[i], cy = b.cy[i], cz = b.cz[i];
+    const double r2 = (cx * cx + cy * cy) + cz * cz;
+    // NaN and infinity fail one of the comparisons: such points are not fused.
+    b.fused[i] = (r2 >= at.min2) & (r2 <= at.max2) ? 1.0 : 0.0;
+    // The sums associate as Eigen's 3x3 product did before this pass (rows 0 and 1 left to
+    // right, row 2 from the right), so maps stayed the same to the bit.
+    const double x = ((at.rotation[0] * cx + at.rotation[3] * cy) + at.rotation[6] * cz) + at.translation[0];
+    const double y = ((at.rotation[1] * cx + at.rotation[4] * cy) + at.rotation[7] * cz) + at.translation[1];
+    const double z = (at.rotation[2] * cx + (at.rotation[5] * cy + at.rotation[8] * cz)) + at.translation[2];
+    b.x[i] = static_cast<float>(x);
+    b.y[i] = static_cast<float>(y);
+    b.z[i] = static_cast<float>(z);
+    b.vx[i] = std::floor(x * at.inverse_voxel);
+    b.vy[i] = std::floor(y * at.inverse_voxel);
+    b.vz[i] = std::floor(z * at.inverse_voxel);
+  }
+}
+
+}  // namespace
+
+PointBinner::PointBinner(double voxel, double min_range, double max_range,
+                         const Eigen::Isometry3d& world_T_camera)
+    : pose_{{}, {}, 1.0 / voxel, min_range * min_range, max_range * max_range} {
+  Eigen::Map<Eigen::Matrix3d>(pose_.rotation) = world_T_camera.linear();
+  Eigen::Map<Eigen::Vector3d>(pose_.translation) = world_T_camera.translation();
+}
+
+void PointBinner::bin(const Eigen::Vector3f* points, size_t n, Batch& out) const {
+  for (size_t i = 0; i < n; ++i) {
+    out.cx[i] = points[i].x();
+    out.cy[i] = points[i].y();
+    out.cz[i] = points[i].z();
+  }
+  bin_batch(n, pose_, out);
+}
+
+}  // namespace sonomap
