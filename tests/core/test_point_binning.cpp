@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Camera points land where the camera pose puts them in the world, in the voxel that holds
+// them; points out of range or not finite are not fused. Truth: Eigen's transform of each
+// point, and floor() of its coordinates over the voxel.
+#include "core/point_binning.hpp"
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using namespace sonomap;
+
+namespace {
+
+// A camera at (1, 2, 1.52) looking along world +x (its optical z), image x to world -y.
+Eigen::Isometry3d camera_pose() {
+  Eigen::Matrix3d r;
+  r << 0, 0, 1,
+      -1, 0, 0,
+       0, -1, 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = r;
+  pose.translation() = Eigen::Vector3d(1.0, 2.0, 1.52);
+  return pose;
+}
+
+}  // namespace
+
+TEST_CASE("A point 2.02 m in front of the camera lands 2.02 m ahead of it in the world, in its voxel",
+          "[point_binning]") {
+  const PointBinner binner(0.05, 0.3, 5.0, camera_pose());
+  PointBinner::Batch b;
+  const Eigen::Vector3f ahead(0.12f, 0.0f, 2.02f);  // 12 cm right of the optical axis
+  binner.bin(&ahead, 1, b);
+  REQUIRE(b.fused[0] == 1.0);
+  CHECK(b.x[0] == Approx(3.02));
+  CHECK(b.y[0] == Approx(1.88));
+  CHECK(b.z[0] == Approx(1.52));
+  CHECK(b.voxel(0) == openvdb::Coord(60, 37, 30));  // 60.4, 37.6, 30.4 voxels
+}
+
+TEST_CASE("Points nearer than the minimum range, beyond the maximum or not finite are not fused",
+          "[point_binning]") {
+  const PointBinner binner(0.05, 0.3, 5.0, camera_pose());
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<Eigen::Vector3f> points{{0, 0, 0.2f}, {0, 0, 0.3f}, {0, 3, 4}, {0, 3.01f, 4},
+                                            {nan, 0, 1}, {0, inf, 1}, {0, 0, -inf}};
+  PointBinner::Batch b;
+  binner.bin(points.data(), points.size(), b);
+  const std::vector<double> fused(b.fused, b.fused + points.size());
+  CHECK(fused == std::vector<double>{0, 1, 1, 0, 0, 0, 0});
+}
+
+TEST_CASE("A full batch places every point as the camera pose does, lane by lane", "[point_binning]") {
+  const Eigen::Isometry3d pose = camera_pose();
+  const double voxel = 0.05;
+  const PointBinner binner(voxel, 0.0, 100.0, pose);
+  std::vector<Eigen::Vector3f> points;
+  for (size_t i = 0; i < PointBinner::kBatch; ++i)
+    points.emplace_back(0.37f * std::sin(0.1f * i), 0.21f * std::cos(0.3f * i) - 0.5f, 0.5f + 0.013f * i);
+  PointBinner::Batch b;
+  binner.bin(points.data(), points.size(), b);
+  for (size_t i = 0; i < points.size(); ++i) {
+    INFO("point " << i);
+    const Eigen::Vector3d world = pose * points[i].cast<double>();
+    REQUIRE(b.fused[i] == 1.0);
+    CHECK(b.x[i] == Approx(world.x()).margin(1e-6));
+    CHECK(b.y[i] == Approx(world.y()).margin(1e-6));
+    CHECK(b.z[i] == Approx(world.z()).margin(1e-6));
+    const Eigen::Vector3d cell = (Eigen::Vector3d(b.x[i], b.y[i], b.z[i]) / voxel).array().floor();
+    // The voxel comes from the double position; its float copy may round across a face.
+    CHECK((Eigen::Vector3d(b.voxel(i).x(), b.voxel(i).y(), b.voxel(i).z()) - cell).cwiseAbs().maxCoeff() <= 1.0);
+  }
+}
