@@ -253,7 +253,9 @@ void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
     const double dx = p.x() - center.x(), dy = p.y() - center.y();
     return dx * dx + dy * dy <= r2;
   };
-  auto farther = [](float lo, float hi, double c) { return std::abs(lo - c) > std::abs(hi - c) ? lo : hi; };
+  auto farther = [](float lo, float hi, double c) {
+    return std::abs(lo - c) > std::abs(hi - c) ? lo : hi;
+  };
   for (int x = x0; x <= x1; x += kLeafDim)
     for (int y = y0; y <= y1; y += kLeafDim)
       for (int z = min_z_; z <= max_z_; z += kLeafDim) {

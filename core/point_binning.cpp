@@ -16,7 +16,7 @@ void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
     const double cx = b.cx[i], cy = b.cy[i], cz = b.cz[i];
     const double r2 = (cx * cx + cy * cy) + cz * cz;
     // NaN and infinity fail one of the comparisons: such points are not fused.
-    b.fused[i] = (r2 >= at.min2) & (r2 <= at.max2) ? 1.0 : 0.0;
+    b.fused[i] = (r2 >= at.min2) & (r2 <= at.max2);
     // The sums associate as Eigen's 3x3 product did before this pass (rows 0 and 1 left to
     // right, row 2 from the right), so maps stayed the same to the bit.
     const double x = ((at.rotation[0] * cx + at.rotation[3] * cy) + at.rotation[6] * cz) + at.translation[0];

@@ -9,6 +9,7 @@
 #include <openvdb/openvdb.h>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace sonomap {
 
@@ -20,7 +21,7 @@ class PointBinner {
     double cx[kBatch], cy[kBatch], cz[kBatch];  // the points in the camera frame
     float x[kBatch], y[kBatch], z[kBatch];       // world position, as point sums add it
     double vx[kBatch], vy[kBatch], vz[kBatch];   // floor(world position / voxel)
-    double fused[kBatch];                        // 1 if the point is fused, else 0
+    int64_t fused[kBatch];                       // 1 if the point is fused, else 0
     openvdb::Coord voxel(size_t i) const {
       return openvdb::Coord(static_cast<int>(vx[i]), static_cast<int>(vy[i]), static_cast<int>(vz[i]));
     }

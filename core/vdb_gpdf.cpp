@@ -337,7 +337,7 @@ void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& p
   openvdb::Coord run(std::numeric_limits<int>::min());
   for (size_t i = begin; i-- > 0;) {  // the run going on at `begin`, if any
     binner.bin(&points[i], 1, b);
-    if (b.fused[0] != 0.0) {
+    if (b.fused[0]) {
       run = b.voxel(0);
       break;
     }
@@ -348,7 +348,7 @@ void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& p
     const size_t n = std::min(PointBinner::kBatch, points.size() - first);
     binner.bin(&points[first], n, b);
     for (size_t k = 0; k < n; ++k) {
-      if (b.fused[k] == 0.0) continue;
+      if (!b.fused[k]) continue;
       const openvdb::Coord v = b.voxel(k);
       if (v != run) {
         if (own) buckets[bucket_of(run)].push_back({run, sum});

@@ -33,7 +33,7 @@ TEST_CASE("A point 2.02 m in front of the camera lands 2.02 m ahead of it in the
   PointBinner::Batch b;
   const Eigen::Vector3f ahead(0.12f, 0.0f, 2.02f);  // 12 cm right of the optical axis
   binner.bin(&ahead, 1, b);
-  REQUIRE(b.fused[0] == 1.0);
+  REQUIRE(b.fused[0] == 1);
   CHECK(b.x[0] == Approx(3.02));
   CHECK(b.y[0] == Approx(1.88));
   CHECK(b.z[0] == Approx(1.52));
@@ -48,8 +48,8 @@ TEST_CASE("Points nearer than the minimum range, beyond the maximum or not finit
                                             {nan, 0, 1}, {0, inf, 1}, {0, 0, -inf}};
   PointBinner::Batch b;
   binner.bin(points.data(), points.size(), b);
-  const std::vector<double> fused(b.fused, b.fused + points.size());
-  CHECK(fused == std::vector<double>{0, 1, 1, 0, 0, 0, 0});
+  const std::vector<int64_t> fused(b.fused, b.fused + points.size());
+  CHECK(fused == std::vector<int64_t>{0, 1, 1, 0, 0, 0, 0});
 }
 
 TEST_CASE("A full batch places every point as the camera pose does, lane by lane", "[point_binning]") {
@@ -64,7 +64,7 @@ TEST_CASE("A full batch places every point as the camera pose does, lane by lane
   for (size_t i = 0; i < points.size(); ++i) {
     INFO("point " << i);
     const Eigen::Vector3d world = pose * points[i].cast<double>();
-    REQUIRE(b.fused[i] == 1.0);
+    REQUIRE(b.fused[i] == 1);
     CHECK(b.x[i] == Approx(world.x()).margin(1e-6));
     CHECK(b.y[i] == Approx(world.y()).margin(1e-6));
     CHECK(b.z[i] == Approx(world.z()).margin(1e-6));
