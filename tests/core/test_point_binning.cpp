@@ -15,12 +15,10 @@ namespace {
 
 // A camera at (1, 2, 1.52) looking along world +x (its optical z), image x to world -y.
 Eigen::Isometry3d camera_pose() {
-  Eigen::Matrix3d r;
-  r << 0, 0, 1,
-      -1, 0, 0,
-       0, -1, 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = r;
+  pose.linear().col(0) = -Eigen::Vector3d::UnitY();  // image x: world -y
+  pose.linear().col(1) = -Eigen::Vector3d::UnitZ();  // image y (down): world -z
+  pose.linear().col(2) = Eigen::Vector3d::UnitX();   // optical axis: world +x
   pose.translation() = Eigen::Vector3d(1.0, 2.0, 1.52);
   return pose;
 }
