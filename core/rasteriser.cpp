@@ -19,7 +19,7 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 // The first pass over a batch of points finds, for each, whether it counts, its squared range,
 // its bin position by a fast arctangent and its row quotient. It is written without branches,
 // over arrays of one type, so that the compiler vectorises it (an AVX2 clone is chosen at run
-// time on x86-64; CMakeLists.txt says why this file needs -fno-trapping-math). The second
+// time on x86-64; core/CMakeLists.txt gives the options it needs and why). The second
 // pass, one point at a time, places the points in their cells.
 constexpr size_t kBatch = 256;
 

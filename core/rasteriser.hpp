@@ -43,7 +43,7 @@ class Rasteriser {
   const RasterConfig& config() const { return config_; }
   const RasterOrigin& origin() const { return origin_; }
 
- // What the per-point pass needs of the config and the origin, as plain numbers.
+  // What the per-point pass needs of the config and the origin, as plain numbers.
   struct Placement {
     double x = 0.0, y = 0.0, ground_z = 0.0, cos_heading = 1.0, sin_heading = 0.0;
     double band_min = 0.0, band_max = 0.0, max_range2 = 0.0, row_height = 1.0;
