@@ -1,16 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "core/point_binning.hpp"
 
+#include "core/vector_isa.hpp"
+
 #include <cmath>
 
 namespace sonomap {
 
 namespace {
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+SONOMAP_VECTOR_LOOP void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
   const PointBinner::Pose at = pose;  // locals: a load inside a select could trap (see core/CMakeLists.txt)
   for (size_t i = 0; i < n; ++i) {
     const double cx = b.cx[i], cy = b.cy[i], cz = b.cz[i];
@@ -31,6 +30,14 @@ void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
   }
 }
 
+void bin_baseline(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) { bin_batch(n, pose, b); }
+SONOMAP_AVX2_KERNEL void bin_avx2(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+  bin_batch(n, pose, b);
+}
+SONOMAP_AVX512_KERNEL void bin_avx512(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+  bin_batch(n, pose, b);
+}
+
 }  // namespace
 
 PointBinner::PointBinner(double voxel, double min_range, double max_range,
@@ -46,7 +53,7 @@ void PointBinner::bin(const Eigen::Vector3f* points, size_t n, Batch& out) const
     out.cy[i] = points[i].y();
     out.cz[i] = points[i].z();
   }
-  bin_batch(n, pose_, out);
+  kernel_for(vector_isa(), &bin_baseline, &bin_avx2, &bin_avx512)(n, pose_, out);
 }
 
 }  // namespace sonomap

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A frame's camera points placed in a world voxel grid, a batch at a time: for each point,
 // whether it is fused (finite, within [min_range, max_range] of the camera), its world
-// position and its voxel. One branch-free pass per batch that the compiler vectorises (an
-// AVX2 clone is chosen at run time on x86-64), as the rasteriser's first pass.
+// position and its voxel. One branch-free pass per batch that the compiler vectorises (a copy
+// per instruction set, core/vector_isa.hpp), as the rasteriser's first pass.
 #pragma once
 
 #include <Eigen/Geometry>

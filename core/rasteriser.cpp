@@ -2,6 +2,7 @@
 #include "core/rasteriser.hpp"
 
 #include "core/parallel.hpp"
+#include "core/vector_isa.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +19,8 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 
 // The first pass over a batch of points finds, for each, whether it counts, its squared range,
 // its bin position by a fast arctangent and its row quotient. It is written without branches,
-// over arrays of one type, so that the compiler vectorises it (an AVX2 clone is chosen at run
-// time on x86-64; core/CMakeLists.txt gives the options it needs and why). The second
+// over arrays of one type, so that the compiler vectorises it (core/vector_isa.hpp: a copy
+// per instruction set; core/CMakeLists.txt gives the options it needs and why). The second
 // pass, one point at a time, places the points in their cells.
 constexpr size_t kBatch = 256;
 
@@ -43,10 +44,7 @@ inline void to_body(const Rasteriser::Placement& at, double dx, double dy, doubl
   y = -at.sin_heading * dx + at.cos_heading * dy;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
+SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
   const Rasteriser::Placement at = placement;  // locals: a load inside a select could trap
   for (size_t i = 0; i < n; ++i) {
     const double height = b.z[i] - at.ground_z;
@@ -74,6 +72,10 @@ void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
     b.near_edge[i] = (above_edge <= at.margin_bins) | (above_edge >= 1.0 - at.margin_bins);
   }
 }
+
+void locate_baseline(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
+SONOMAP_AVX2_KERNEL void locate_avx2(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
+SONOMAP_AVX512_KERNEL void locate_avx512(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
 
 // Whether a sample at squared range `range2` may be nearer than what `cell` holds. The cell
 // takes it when float(sqrt(range2)) < cell.range; range2 >= cell.range^2 (exact in double for
@@ -135,6 +137,7 @@ inline int Rasteriser::last_row_fix(int row, const Eigen::Vector3f& point) const
 }
 
 void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t count) const {
+  const auto locate_batch = kernel_for(vector_isa(), &locate_baseline, &locate_avx2, &locate_avx512);
   Batch b;
   for (size_t begin = 0; begin < count; begin += kBatch) {
     const size_t n = std::min(kBatch, count - begin);
@@ -143,7 +146,7 @@ void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t coun
       b.y[k] = points[begin + k].y();
       b.z[k] = points[begin + k].z();
     }
-    locate(n, at_, b);
+    locate_batch(n, at_, b);
     for (size_t k = 0; k < n; ++k) {
       if (!b.counts[k]) continue;
       const Eigen::Vector3f& point = points[begin + k];

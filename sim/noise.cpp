@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/noise.hpp"
 
-#include "sim/vector_isa.hpp"
+#include "core/vector_isa.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -3,7 +3,7 @@
 
 #include "sim/primitives.hpp"
 #include "sim/trajectory.hpp"
-#include "sim/vector_isa.hpp"
+#include "core/vector_isa.hpp"
 #include "sim/world_geometry.hpp"
 
 #include <embree3/rtcore.h>

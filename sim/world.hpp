@@ -77,7 +77,7 @@ class World {
   // Traces one ray per pixel (packets of 16 = 4x4 pixels, rows of packets spread over TBB
   // threads) into `hits`, reusing its buffers. Every ray is independent, so the result does not
   // depend on the thread count; the incidence angles are computed by vectorised row loops
-  // (vector_isa.hpp), the same bits with any instruction set.
+  // (core/vector_isa.hpp), the same bits with any instruction set.
   void cast(const PinholeRays& rays, RayHits& hits) const;
   RayHits cast(const PinholeRays& rays) const {
     RayHits hits;

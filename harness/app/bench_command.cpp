@@ -8,7 +8,7 @@
 #include "sim/noise.hpp"
 #include "sim/primitives.hpp"
 #include "sim/simulation.hpp"
-#include "sim/vector_isa.hpp"
+#include "core/vector_isa.hpp"
 #include "sim/world.hpp"
 
 #include <tbb/global_control.h>
@@ -181,7 +181,7 @@ void bench_render(const BenchRenderOptions& options, const GlobalOptions& global
   std::printf("bench render: '%s', %dx%d, %zu triangles, %d frames, noise %s, %s loops (medians)\n",
               scenario.name.c_str(), scenario.camera.width, scenario.camera.height, triangles, count,
               scenario.noise.model == sim::NoiseSpec::Model::None ? "none" : "kinect",
-              sim::name_of(sim::vector_isa()));
+              name_of(vector_isa()));
   std::printf("rays: Embree casting only; noise: the noise model alone (sim::apply_noise on the exact\n"
               "image); render: Simulation::render (rays, noise, points, poses), Mrays/s = pixels / render.\n"
               "wall = elapsed time; cpu = CPU time of all threads (the 1-thread cpu figure is the\n"

@@ -9,6 +9,7 @@
 #include "core/rasteriser.hpp"
 #include "core/stopwatch.hpp"
 #include "core/tsdf.hpp"
+#include "core/vector_isa.hpp"
 #include "harness/app/mapper_factory.hpp"
 #include "core/rasterise_map.hpp"
 #include "harness/formats/scenario_yaml.hpp"
@@ -288,6 +289,7 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
            {"frames", json::array()},
            {"every", o.every},
            {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
+           {"vector_loops", name_of(vector_isa())},
            {"open3d", {{"class", "ScalableTSDFVolume"},
                        {"sdf_trunc_voxels", kPeer.truncation / kPeer.voxel},
                        {"range_m", {kPeer.min_range, kPeer.max_range}},
@@ -368,8 +370,9 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
         cell.map_ratio = cell.median_of("map") / ref.median_of("map");
       }
 
-  fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), medians per frame in ms\n",
-             scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every);
+  fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), {} loops, medians per frame in ms\n",
+             scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every,
+             name_of(vector_isa()));
   fmt::print("map = the mapper's integrate (open3d: depth copy + Integrate, truncation {:g} voxels); "
              "raster = circle + cylinder\nfrom the map's surface samples (as `run`; open3d: mesh "
              "extraction included); frame = map + raster;\ncpu = process CPU time of the frame (all "

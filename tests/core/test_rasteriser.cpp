@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Hand-placed points give hand-computed bins (docs/conventions.md "Azimuth", "Bins", "The circle
 // and the cylinder").
+#include "../vector_isas.hpp"
 #include "core/rasteriser.hpp"
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <utility>
 
 using namespace sonomap;
 
@@ -242,5 +245,40 @@ TEST_CASE("Every direction lands in the bin floor(atan2 / bin width) gives, also
       INFO("azimuth " << azimuth << ", " << bins << " bins, " << copies << " copies");
       REQUIRE(known_bins(r.circle()) == std::vector<int>{expected});
     }
+  }
+}
+
+TEST_CASE("The baseline, AVX2 and AVX-512 copies of the batch pass fill every cell to the same bit",
+          "[rasteriser]") {
+  // 50 000 points around a listener at (1.3, -0.7) facing 37 degrees: every azimuth, ranges
+  // from the axis to beyond the maximum, heights from under the band to over it, and points
+  // not finite among them (so the parts run in parallel, and every branch of the pass runs).
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 50000; ++i) {
+    const double golden = 0.6180339887498949 * i;
+    const double range = 7.0 * (golden - std::floor(golden)), height = -0.3 + 2.4 * std::fmod(0.7548776662 * i, 1.0);
+    points.push_back(Eigen::Vector3f(1.3f, -0.7f, 0.1f) + polar(360.0 * std::fmod(0.5698402910 * i, 1.0), range, height));
+    if (i % 997 == 0) points.back()[i % 3] = nan;
+  }
+  RasterOrigin origin;
+  origin.position = Eigen::Vector3d(1.3, -0.7, 1.7);
+  origin.heading = 37.0 * kDeg;
+  origin.ground_z = 0.1;
+  const auto rasterised = [&](VectorIsa isa) {
+    const ScopedVectorIsa code(isa);
+    Rasteriser r{RasterConfig{}};
+    r.reset(origin);
+    r.add(points);
+    return std::make_pair(r.circle(), r.cylinder());
+  };
+  const auto baseline = rasterised(VectorIsa::Baseline);
+  CHECK(baseline.first.known_count() == 360);
+  CHECK(baseline.second.known_count() > 360 * 10);
+  for (VectorIsa isa : vector_isas_beside_baseline()) {
+    INFO(name_of(isa));
+    const auto copy = rasterised(isa);
+    CHECK(same_bits(copy.first.bins, baseline.first.bins));
+    CHECK(same_bits(copy.second.cells, baseline.second.cells));
   }
 }

@@ -70,6 +70,8 @@ TEST_CASE("bench map times every stage of every mapper and Open3D's surface agre
   CHECK(check.at("open3d_vertices").get<int>() > 1000);
   CHECK(check.at("median_distance_m").get<double>() < 0.1);
   CHECK(bench.at("peak_rss_mb").get<double>() > 0.0);
+  // The instruction set of the vectorised loops, which the figures depend on.
+  CHECK(std::set<std::string>{"baseline", "AVX2", "AVX-512"}.count(bench.at("vector_loops")) == 1);
 }
 
 TEST_CASE("bench map reports what a coarser voxel and a second thread change, per mapper", "[cli][bench]") {

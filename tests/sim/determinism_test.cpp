@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Same scenario and seed: bit-identical frames across reruns, render order, thread counts and
 // instruction sets.
+#include "../vector_isas.hpp"
 #include "scenes.hpp"
 #include "sim/depth_camera.hpp"
 #include "sim/noise.hpp"
 #include "sim/simulation.hpp"
-#include "sim/vector_isa.hpp"
 #include "sim/world.hpp"
 
 #include <catch2/catch.hpp>
@@ -17,6 +17,9 @@
 
 using namespace sonomap::sim;
 using sonomap::Frame;
+using sonomap::ScopedVectorIsa;
+using sonomap::VectorIsa;
+using sonomap::vector_isa;
 
 namespace {
 
@@ -127,23 +130,6 @@ Frame rendered(const Scenario& s, int index, VectorIsa isa, int threads) {
   return sim.render(index);
 }
 
-template <typename T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
-
-// The instruction sets this CPU runs besides the baseline.
-std::vector<VectorIsa> vector_isas() {
-  std::vector<VectorIsa> isas;
-  for (VectorIsa isa : {VectorIsa::Avx2, VectorIsa::Avx512}) {
-    if (supported(isa))
-      isas.push_back(isa);
-    else
-      WARN("instruction set " << static_cast<int>(isa) << " not on this CPU: its code is not compared");
-  }
-  return isas;
-}
-
 // The exact image (depth and incidence) of frame 17 of `s`, rays cast with `isa`.
 DepthImage traced(const Scenario& s, VectorIsa isa) {
   const ScopedVectorIsa code(isa);
@@ -162,7 +148,7 @@ DepthImage noisy(const DepthImage& truth, const NoiseSpec& spec, VectorIsa isa, 
 
 }  // namespace
 
-// The vectorised loops (sim/vector_isa.hpp) must give the baseline's bits. Compared before
+// The vectorised loops (core/vector_isa.hpp) must give the baseline's bits. Compared before
 // quantisation, which would hide a difference in the last bits of the noise or the angles.
 TEST_CASE("the baseline, AVX2 and AVX-512 code give the same rays and noise to the bit, with 1 and 2 threads",
           "[sim][determinism]") {
@@ -176,7 +162,7 @@ TEST_CASE("the baseline, AVX2 and AVX-512 code give the same rays and noise to t
     spec.quantisation = false;
     const DepthImage noise = noisy(truth, spec, VectorIsa::Baseline, 1);
     CHECK(same_bits(noise.z, noisy(truth, spec, VectorIsa::Baseline, 2).z));
-    for (VectorIsa isa : vector_isas()) {
+    for (VectorIsa isa : vector_isas_beside_baseline()) {
       INFO("instruction set " << static_cast<int>(isa));
       const DepthImage rays = traced(s, isa);
       CHECK(same_bits(rays.z, truth.z));

@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The instruction set of the sensor's per-pixel loops (noise rows, ray incidence). Those loops
-// are written once as plain loops (SONOMAP_VECTOR_LOOP) and compiled three times: for the
+// The instruction set of the vectorised loops: the sensor's per-pixel loops (noise rows, ray
+// incidence), the rasteriser's first pass and the point binning's batch pass. Each loop is
+// written once as a plain loop (SONOMAP_VECTOR_LOOP) and compiled three times: for the
 // baseline x86-64 instruction set and, inside SONOMAP_AVX2_KERNEL and SONOMAP_AVX512_KERNEL
 // functions, for AVX2 and AVX-512, chosen at run time (kernel_for). All give the same bits:
-// only IEEE basic operations and sqrt, and no fused multiply-add (it rounds once where the
-// baseline rounds twice; "fma" is not in the AVX2 target, and sim/ builds with
+// only IEEE basic operations, sqrt and floor, and no fused multiply-add (it rounds once where
+// the baseline rounds twice; "fma" is not in the AVX2 target, and these files build with
 // -ffp-contract=off, so the AVX-512 code, whose instruction set has it, never contracts).
-// Tests compare the paths on full frames.
+// Tests compare the copies on the same input, bit for bit.
 #pragma once
 
-namespace sonomap::sim {
+namespace sonomap {
 
 enum class VectorIsa { Baseline, Avx2, Avx512 };
 
@@ -22,8 +23,8 @@ VectorIsa vector_isa();
 // "baseline", "AVX2" or "AVX-512" (for reports).
 const char* name_of(VectorIsa isa);
 
-// Limits the sensor's loops to `isa` (which must be supported) while it lives, process-wide:
-// tests use it to run the baseline and the AVX2 paths on the same frame.
+// Limits the vectorised loops to `isa` (which must be supported) while it lives,
+// process-wide: tests use it to run the baseline, AVX2 and AVX-512 copies on the same input.
 class ScopedVectorIsa {
  public:
   explicit ScopedVectorIsa(VectorIsa isa);
@@ -41,7 +42,7 @@ Kernel kernel_for(VectorIsa isa, Kernel baseline, Kernel avx2, Kernel avx512) {
   return isa == VectorIsa::Avx512 ? avx512 : isa == VectorIsa::Avx2 ? avx2 : baseline;
 }
 
-}  // namespace sonomap::sim
+}  // namespace sonomap
 
 // A loop body inlined into every copy (kernels must call only such functions in hot loops).
 #define SONOMAP_VECTOR_LOOP inline __attribute__((always_inline))

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "sim/vector_isa.hpp"
+#include "core/vector_isa.hpp"
 
 #include <atomic>
 #include <stdexcept>
 
-namespace sonomap::sim {
+namespace sonomap {
 
 namespace {
 
@@ -52,4 +52,4 @@ ScopedVectorIsa::ScopedVectorIsa(VectorIsa isa) : previous_(vector_isa()) {
 
 ScopedVectorIsa::~ScopedVectorIsa() { current().store(previous_); }
 
-}  // namespace sonomap::sim
+}  // namespace sonomap
