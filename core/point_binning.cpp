@@ -10,7 +10,7 @@ namespace sonomap {
 namespace {
 
 SONOMAP_VECTOR_LOOP void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
-  const PointBinner::Pose at = pose;  // locals: a load inside a select could trap (see core/CMakeLists.txt)
+  const PointBinner::Pose at = pose;  // locals: a load inside a select could trap (see the top-level CMakeLists.txt)
   for (size_t i = 0; i < n; ++i) {
     const double cx = b.cx[i], cy = b.cy[i], cz = b.cz[i];
     const double r2 = (cx * cx + cy * cy) + cz * cz;

@@ -20,7 +20,7 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 // The first pass over a batch of points finds, for each, whether it counts, its squared range,
 // its bin position by a fast arctangent and its row quotient. It is written without branches,
 // over arrays of one type, so that the compiler vectorises it (core/vector_isa.hpp: a copy
-// per instruction set; core/CMakeLists.txt gives the options it needs and why). The second
+// per instruction set; the top-level CMakeLists.txt gives the options it needs and why). The second
 // pass, one point at a time, places the points in their cells.
 constexpr size_t kBatch = 256;
 
