@@ -68,13 +68,13 @@ struct QueryUpdate {
 // off (random box rooms: bins clipping a box's vertical edge read the wall behind). Near the
 // surface a centre gets a free-space value only if its pixel and their 8 neighbours (mixed
 // pixels at silhouettes report the far side) all measured something farther. Frames without
-// a depth image (point clouds) skip the check.
+// a depth image (point clouds) skip the check; a frame whose image is not width x height
+// pixels is rejected (std::invalid_argument), not read as a point cloud.
 class DepthView {
  public:
   explicit DepthView(const Frame& frame)
       : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
-        usable_(frame.intrinsics.valid() && frame.width > 0 && frame.height > 0 &&
-                frame.depth.size() == static_cast<size_t>(frame.width) * frame.height) {}
+        usable_(has_depth_image(frame)) {}  // throws when the image is not width x height
 
   // In the image, and every measured depth of its pixel and the 8 around it is farther.
   bool seen_in_front(const Eigen::Vector3d& world) const {

@@ -233,6 +233,14 @@ TEST_CASE("VDB-GPDF: bad input is rejected or skipped, never fused", "[vdb_gpdf]
   Frame skewed = test::render(box_scene(), poses[0], 10);
   skewed.world_T_camera.linear() *= 1.1;  // not orthonormal
   CHECK_THROWS_AS(dirty.integrate(skewed), std::invalid_argument);
+  // The depth image is read beside the points (which voxel centres the camera saw free): one
+  // that is not width x height pixels is a broken frame, not a point cloud without an image.
+  Frame short_image = test::render(box_scene(), poses[1], 11);
+  short_image.depth.pop_back();
+  CHECK_THROWS_WITH(dirty.integrate(short_image), Catch::Contains("frame 11") && Catch::Contains("width x height"));
+  Frame no_width = test::render(box_scene(), poses[1], 12);
+  no_width.width = 0;
+  CHECK_THROWS_AS(dirty.integrate(no_width), std::invalid_argument);
   CHECK(surface(dirty) == before);
 
   VdbGpdfConfig bad;
