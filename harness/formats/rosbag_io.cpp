@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/formats/rosbag_io.hpp"
 
+#include "harness/formats/rosbag_wire.hpp"
 #include "harness/support/errors.hpp"
 
 #include <geometry_msgs/PoseStamped.h>
@@ -22,12 +23,31 @@ namespace fs = std::filesystem;
 namespace sonomap::harness {
 namespace {
 
+// The wire format each message type is checked against (a type not listed does not compile).
+template <typename T>
+struct MessageKind;
+template <>
+struct MessageKind<sensor_msgs::Image> : std::integral_constant<BagMessageKind, BagMessageKind::Image> {};
+template <>
+struct MessageKind<sensor_msgs::PointCloud2>
+    : std::integral_constant<BagMessageKind, BagMessageKind::PointCloud2> {};
+template <>
+struct MessageKind<sensor_msgs::CameraInfo>
+    : std::integral_constant<BagMessageKind, BagMessageKind::CameraInfo> {};
+template <>
+struct MessageKind<geometry_msgs::TransformStamped>
+    : std::integral_constant<BagMessageKind, BagMessageKind::TransformStamped> {};
+template <>
+struct MessageKind<geometry_msgs::PoseStamped>
+    : std::integral_constant<BagMessageKind, BagMessageKind::PoseStamped> {};
+
 // The bag, opened for reading, with errors that name it and the topic.
 class BagFile {
  public:
   explicit BagFile(const fs::path& file) : file_(file) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) throw InputError(file.string(), 0, "", "missing or not a regular file");
+    check_bag_records(file);
     try {
       bag_.open(file.string(), rosbag::bagmode::Read);
     } catch (const ros::Exception& e) {
@@ -56,12 +76,23 @@ class BagFile {
     throw InputError(file_.string() + ": topic " + topic +
                      (index >= 0 ? ", message " + std::to_string(index) : std::string()) + ": " + what);
   }
-  // Message `index` of a View, as T (null: it is another type), with read errors named.
+  // Message `index` of a View, as T (null: it is another type), with read errors named. Its
+  // bytes are checked (bag_message_fits) before ROS deserialises them.
   template <typename T>
   boost::shared_ptr<T> instantiate(const rosbag::MessageInstance& m, long long index) const {
-    boost::shared_ptr<T> message;
+    if (!m.isType<T>()) return nullptr;
+    auto message = boost::make_shared<T>();
     try {
-      message = m.instantiate<T>();
+      std::vector<std::uint8_t>& bytes = message_bytes_;
+      if (m.size() > kMaxBagMessageBytes)
+        fail(m.getTopic(), index, "the message claims " + std::to_string(m.size()) + " bytes (corrupt bag)");
+      bytes.resize(m.size());
+      ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+      m.write(out);
+      if (!bag_message_fits(MessageKind<T>::value, bytes.data(), bytes.size()))
+        fail(m.getTopic(), index, "a length in the message runs past its end (corrupt bag)");
+      ros::serialization::IStream in(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+      ros::serialization::deserialize(in, *message);
     } catch (const ros::Exception& e) {
       fail(m.getTopic(), index, std::string("cannot read the message (truncated bag?): ") + e.what());
     }
@@ -76,6 +107,7 @@ class BagFile {
   }
   fs::path file_;
   rosbag::Bag bag_;
+  mutable std::vector<std::uint8_t> message_bytes_;  // reused: a depth image is a megabyte
 };
 
 struct StampedPose {

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // ROS1 bags in: the smoke scene written as a bag (32FC1 depth, camera_info, the body's pose as a
 // TransformStamped, like a tracking marker) runs from a sequence file and gives the direct
-// run's circle within float32 rounding. Bad bags (truncated, a missing topic, a wrong message
-// type, stamps out of order) exit 2 naming the topic and the message.
+// run's circle within float32 rounding. Bad bags (truncated, a corrupt length, a missing topic,
+// a wrong message type, stamps out of order) exit 2 naming the place: the record's byte, or the
+// topic and the message.
 #include "test_sequence_support.hpp"
 
 #include "harness/formats/rosbag_io.hpp"
@@ -47,6 +48,14 @@ fs::path tiny_bag(const fs::path& dir, const std::vector<std::pair<double, doubl
   for (int i = 0; i < 5; ++i) bag.transform("/vicon/body", kStart + i, "world", "body", Eigen::Isometry3d::Identity());
   bag.close();
   return file;
+}
+
+// Writes `value` little-endian at byte `at` of `file` (a length field of the bag format).
+void overwrite_u32(const fs::path& file, size_t at, std::uint32_t value) {
+  std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekp(static_cast<std::streamoff>(at));
+  for (int i = 0; i < 4; ++i) f.put(static_cast<char>((value >> (8 * i)) & 0xFF));
+  REQUIRE(f.good());
 }
 
 test::CliResult run_cli(const fs::path& sequence, const fs::path& out) {
@@ -141,6 +150,39 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     CHECK(result.status == 2);
     CHECK_THAT(result.output, Catch::Contains("tiny.bag"));
     CHECK_THAT(result.output, Catch::Contains("cannot read the ROS1 bag"));
+  }
+  // rosbag and ROS's deserialiser size their buffers by a length field before reading: a
+  // corrupt length must be an error naming the place, not gigabytes asked for.
+  SECTION("a record claiming a header longer than the file") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    overwrite_u32(bag, 13, 0xFFFFFFF0u);  // the first record, after "#ROSBAG V2.0\n"
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("cannot read the ROS1 bag") &&
+                                  Catch::Contains("the record at byte 13 claims a 4294967280-byte header"));
+  }
+  SECTION("a bag whose version line names another log type is read as a bag all the same") {
+    // rosbag takes "#ROS<anything> V2.0" as version 2.0: so must the length checks.
+    tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const fs::path bag = scratch.path() / "tiny.bag";
+    const std::string bytes = test::text_of(bag);
+    std::ofstream(bag, std::ios::binary | std::ios::trunc) << "#ROS_count=#ROSBAG" << bytes.substr(7);
+    overwrite_u32(bag, 13 + 11, 0xFFFFFFF0u);  // the first record's header length
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte 24 claims a 4294967280-byte header"));
+  }
+  SECTION("an image whose pixel count runs past the message") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}, {kStart + 1, 0.0}});
+    // sensor_msgs/Image: ..., encoding "32FC1", is_bigendian (1 byte), step (4), data count (4).
+    const std::string bytes = test::text_of(bag);
+    const size_t encoding = bytes.find("32FC1");
+    REQUIRE(encoding != std::string::npos);
+    overwrite_u32(bag, encoding + 5 + 1 + 4, 0x7FFFFFFFu);  // 2 GiB of pixels in a 48-byte array
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("topic /camera/depth/image, message 0") &&
+                                  Catch::Contains("runs past its end"));
   }
   SECTION("a missing topic") {
     tiny_bag(scratch.path(), {{kStart, 0.0}});
