@@ -83,10 +83,11 @@ class BagFile {
     if (!m.isType<T>()) return nullptr;
     auto message = boost::make_shared<T>();
     try {
+      const std::uint32_t size = m.size();  // each call reads the record's header again
+      if (size > kMaxBagMessageBytes)
+        fail(m.getTopic(), index, "the message claims " + std::to_string(size) + " bytes (corrupt bag)");
       std::vector<std::uint8_t>& bytes = message_bytes_;
-      if (m.size() > kMaxBagMessageBytes)
-        fail(m.getTopic(), index, "the message claims " + std::to_string(m.size()) + " bytes (corrupt bag)");
-      bytes.resize(m.size());
+      bytes.resize(size);
       ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
       m.write(out);
       if (!bag_message_fits(MessageKind<T>::value, bytes.data(), bytes.size()))
