@@ -2,6 +2,7 @@
 #include "core/depth_only.hpp"
 
 #include <chrono>
+#include <cmath>
 
 namespace sonomap {
 
@@ -24,12 +25,18 @@ void DepthOnlyMapper::integrate(const Frame& frame) {
 
 void DepthOnlyMapper::surface_points(const Eigen::Vector3d& center, double radius,
                                      std::vector<Eigen::Vector3f>& out) const {
+  surface_points_in_band(center, radius, -INFINITY, INFINITY, out);
+}
+
+void DepthOnlyMapper::surface_points_in_band(const Eigen::Vector3d& center, double radius,
+                                             double z_min, double z_max,
+                                             std::vector<Eigen::Vector3f>& out) const {
   out.clear();
   const double radius2 = radius * radius;
   for (const Eigen::Vector3f& p : points_) {
     const double dx = p.x() - center.x();
     const double dy = p.y() - center.y();
-    if (dx * dx + dy * dy <= radius2) out.push_back(p);
+    if (dx * dx + dy * dy <= radius2 && p.z() >= z_min && p.z() <= z_max) out.push_back(p);
   }
 }
 

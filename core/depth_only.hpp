@@ -25,6 +25,8 @@ class DepthOnlyMapper final : public Mapper {
   // (`out` is replaced). Pixels are dense on the surfaces the camera sees.
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const override;
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
 
   // No distance field: every query reports observed = false.
   void query(const std::vector<Eigen::Vector3f>& points,

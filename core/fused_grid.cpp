@@ -32,6 +32,12 @@ void FusedGrid::surface_points(const Eigen::Vector3d& center, double radius,
   cache_.collect(center, radius, out);
 }
 
+void FusedGrid::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                                       double z_max, std::vector<Eigen::Vector3f>& out) const {
+  out.clear();
+  cache_.collect(center, radius, out, z_min, z_max);
+}
+
 void FusedGrid::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                              std::vector<Eigen::Vector3i>& triangles) const {
   SurfaceMesh mesh = march_grid(*grid_, voxel_, min_weight_);

@@ -39,6 +39,9 @@ class FusedGrid {
   // most half a voxel apart (the Mapper contract of both maps that fuse into this grid).
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const;
+  // The same restricted to heights z in [z_min, z_max]: leaves outside them are not read.
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const;
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                     std::vector<Eigen::Vector3i>& triangles) const;
   size_t memory_bytes() const;

@@ -4,9 +4,9 @@
 //
 // How a run drives a mapper: a factory (harness/app/mapper_registry.hpp) builds one fresh
 // mapper per run; config_entries() is read once; then for every frame in order, integrate()
-// and last_stage_times(); on evaluated frames surface_points() around the listener (and, when
-// the EDF comparison is on, query()); surface_mesh() once at the end; memory_bytes() by
-// `bench map`.
+// and last_stage_times(); on evaluated frames surface_points_in_band() around the listener (and,
+// when the EDF comparison is on, query()); surface_points() for a sweep's room; surface_mesh()
+// once at the end; memory_bytes() by `bench map`.
 // Thread-safety: the harness never calls one mapper from two threads at once, and const calls
 // never overlap integrate(). A mapper may use TBB inside its calls (`--threads` caps it), but
 // its results must not depend on the thread count or on timing: same frames, same output.
@@ -56,6 +56,17 @@ class Mapper {
   // the obstacle band; their order must be the same on every run.
   virtual void surface_points(const Eigen::Vector3d& center, double radius,
                               std::vector<Eigen::Vector3f>& out) const = 0;
+  // What the rasters read every evaluated frame: the samples of surface_points() whose height
+  // z lies in [z_min, z_max] (world), the obstacle band, in surface_points()' order. A map that
+  // keeps its samples by place can skip the floor and the ceiling without reading them.
+  // Returning samples outside the band is allowed (the rasteriser ignores them); dropping one
+  // inside is not. The default returns all of surface_points().
+  virtual void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                                      double z_max, std::vector<Eigen::Vector3f>& out) const {
+    (void)z_min;
+    (void)z_max;
+    surface_points(center, radius, out);
+  }
   // Distance field queries (batched, world points): `out` gets exactly one answer per point.
   // Maps without a field answer observed = false everywhere.
   virtual void query(const std::vector<Eigen::Vector3f>& points,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 namespace sonomap {
 namespace {
@@ -158,6 +159,65 @@ SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float 
   return mesh;
 }
 
+namespace {
+
+// Emits each sample of a mesh once. Corners that are vertices are emitted the first time
+// only. A point inside an edge is computed from the edge's lower-numbered vertex, so two
+// triangles that divide their shared edge alike compute it bit for bit alike, and only the
+// first emits it. A repeat never changes a raster, whose cells keep the first point met at
+// equal range; without this, nearly half of a flat wall's samples would be repeats.
+class SampleEmitter {
+ public:
+  SampleEmitter(const SurfaceMesh& mesh, std::vector<Eigen::Vector3f>& out)
+      : mesh_(mesh), out_(out), vertex_emitted_(mesh.vertices.size(), false) {
+    // An open-addressing table of the divided edges, at most 3/4 full: each triangle adds
+    // at most 3 edges. No allocation per edge: this runs for every leaf a frame touches.
+    size_t capacity = 16;
+    while (capacity < 4 * mesh.triangles.size()) capacity *= 2;
+    edges_.assign(capacity, DividedEdge{});
+    mask_ = capacity - 1;
+  }
+
+  void vertex(int v) {
+    if (vertex_emitted_[v]) return;
+    vertex_emitted_[v] = true;
+    out_.push_back(mesh_.vertices[v]);
+  }
+  // The inner points of edge (p, q) divided in n: step s of n from p, for s in (0, n).
+  void edge(int p, int q, int n) {
+    const int lo = std::min(p, q), hi = std::max(p, q);
+    if (!first_division(static_cast<uint64_t>(lo) * mesh_.vertices.size() + static_cast<uint64_t>(hi), n)) return;
+    const Eigen::Vector3f a = mesh_.vertices[lo], d = mesh_.vertices[hi] - a;
+    for (int s = 1; s < n; ++s) out_.push_back(a + d * (static_cast<float>(s) / n));
+  }
+  void inner(const Eigen::Vector3f& p) { out_.push_back(p); }
+
+ private:
+  struct DividedEdge {
+    uint64_t key_plus_one = 0;  // 0: an empty slot
+    int divisions = 0;
+  };
+  // False if the edge was divided in n before; the first division of an edge is recorded.
+  bool first_division(uint64_t key, int n) {
+    for (size_t slot = (key * 0x9E3779B97F4A7C15ull) >> 32 & mask_;; slot = (slot + 1) & mask_) {
+      DividedEdge& e = edges_[slot];
+      if (e.key_plus_one == 0) {
+        e = DividedEdge{key + 1, n};
+        return true;
+      }
+      if (e.key_plus_one == key + 1) return e.divisions != n;
+    }
+  }
+
+  const SurfaceMesh& mesh_;
+  std::vector<Eigen::Vector3f>& out_;
+  std::vector<bool> vertex_emitted_;
+  std::vector<DividedEdge> edges_;
+  size_t mask_ = 0;
+};
+
+}  // namespace
+
 void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out) {
   std::vector<int> divisions(mesh.triangles.size());
   size_t count = 0;
@@ -169,26 +229,18 @@ void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::
     count += static_cast<size_t>(n + 1) * (n + 2) / 2;
   }
   out.reserve(out.size() + count);  // one allocation instead of a growing vector's many
-  // About six triangles share a vertex and each would emit it as a corner, half of all
-  // samples. A corner that computes to its vertex exactly is emitted the first time only: a
-  // repeat never changes a raster, whose cells keep the first point met at equal range.
-  std::vector<bool> vertex_emitted(mesh.vertices.size(), false);
-  auto emit = [&](const Eigen::Vector3f& p, int corner_vertex) {
-    if (corner_vertex >= 0 && p == mesh.vertices[corner_vertex]) {
-      if (vertex_emitted[corner_vertex]) return;
-      vertex_emitted[corner_vertex] = true;
-    }
-    out.push_back(p);
-  };
+  SampleEmitter emit(mesh, out);
   for (size_t k = 0; k < mesh.triangles.size(); ++k) {
     const Eigen::Vector3i& t = mesh.triangles[k];
-    const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
     const int n = divisions[k];
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; j <= n - i; ++j) {
-        const int corner = i == 0 ? (j == 0 ? t[0] : j == n ? t[2] : -1) : (i == n ? t[1] : -1);
-        emit(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n), corner);
-      }
+    // The grid a + (b - a) i / n + (c - a) j / n, i + j <= n, in the order: corners, the
+    // edges ab, bc, ca, then the inner points.
+    for (int v = 0; v < 3; ++v) emit.vertex(t[v]);
+    for (int e = 0; e < 3; ++e) emit.edge(t[e], t[(e + 1) % 3], n);
+    const Eigen::Vector3f a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
+    for (int i = 1; i < n; ++i)
+      for (int j = 1; j < n - i; ++j)
+        emit.inner(a + (b - a) * (static_cast<float>(i) / n) + (c - a) * (static_cast<float>(j) / n));
   }
 }
 
@@ -233,16 +285,16 @@ void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vec
     max_z_ = std::max(max_z_, leaf_origin.z());
   }
   LeafSamples& leaf = leaves_[leaf_origin];
-  leaf.min_xy = leaf.max_xy = samples.front().head<2>();
+  leaf.min = leaf.max = samples.front();
   for (const Eigen::Vector3f& p : samples) {
-    leaf.min_xy = leaf.min_xy.cwiseMin(p.head<2>());
-    leaf.max_xy = leaf.max_xy.cwiseMax(p.head<2>());
+    leaf.min = leaf.min.cwiseMin(p);
+    leaf.max = leaf.max.cwiseMax(p);
   }
   leaf.points = std::move(samples);
 }
 
 void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
-                           std::vector<Eigen::Vector3f>& out) const {
+                           std::vector<Eigen::Vector3f>& out, double z_min, double z_max) const {
   if (leaves_.empty() || !(radius >= 0.0)) return;
   const int x0 = static_cast<int>(std::floor((center.x() - radius) / leaf_size_)) * kLeafDim;
   const int x1 = static_cast<int>(std::floor((center.x() + radius) / leaf_size_)) * kLeafDim;
@@ -253,6 +305,7 @@ void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
     const double dx = p.x() - center.x(), dy = p.y() - center.y();
     return dx * dx + dy * dy <= r2;
   };
+  auto in_heights = [&](float z) { return z >= z_min && z <= z_max; };
   auto farther = [](float lo, float hi, double c) {
     return std::abs(lo - c) > std::abs(hi - c) ? lo : hi;
   };
@@ -262,16 +315,18 @@ void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
         const auto it = leaves_.find(openvdb::Coord(x, y, z));
         if (it == leaves_.end()) continue;
         const LeafSamples& leaf = it->second;
+        if (leaf.max.z() < z_min || leaf.min.z() > z_max) continue;
         // within() rounds monotonically in each coordinate: when the farthest corner of the
-        // leaf's bounds is within, every sample is. Copy them all.
-        const Eigen::Vector2f far_corner(farther(leaf.min_xy.x(), leaf.max_xy.x(), center.x()),
-                                         farther(leaf.min_xy.y(), leaf.max_xy.y(), center.y()));
-        if (within(far_corner)) {
+        // leaf's bounds is within, every sample is. Then, if all heights are in, copy them all.
+        const Eigen::Vector2f far_corner(farther(leaf.min.x(), leaf.max.x(), center.x()),
+                                         farther(leaf.min.y(), leaf.max.y(), center.y()));
+        const bool all_within = within(far_corner);
+        if (all_within && in_heights(leaf.min.z()) && in_heights(leaf.max.z())) {
           out.insert(out.end(), leaf.points.begin(), leaf.points.end());
           continue;
         }
         for (const auto& p : leaf.points)
-          if (within(p.head<2>())) out.push_back(p);
+          if ((all_within || within(p.head<2>())) && in_heights(p.z())) out.push_back(p);
       }
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -63,7 +64,8 @@ SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float 
 
 // Points on the triangles themselves, so that neighbouring samples are at most `spacing`
 // apart along every edge: each triangle is subdivided into n^2 sub-triangles with
-// n = ceil(longest edge / spacing) and all their corners are appended, a mesh vertex once.
+// n = ceil(longest edge / spacing) and all their corners are appended, each once: a mesh
+// vertex once, and the points inside an edge once when its triangles divide it alike.
 void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::Vector3f>& out);
 
 // The voxels of one leaf (origin, one bit per voxel in the leaf's own order) that changed.
@@ -87,9 +89,11 @@ class SurfaceCache {
   explicit SurfaceCache(double leaf_size = 0.4) : leaf_size_(leaf_size) {}
   // Replaces (or, if samples is empty, drops) the samples of one leaf.
   void set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples);
-  // Appends all samples within horizontal distance `radius` of center.
-  void collect(const Eigen::Vector3d& center, double radius,
-               std::vector<Eigen::Vector3f>& out) const;
+  // Appends the samples within horizontal distance `radius` of center whose height z lies in
+  // [z_min, z_max], leaf by leaf in a fixed order; a leaf whose samples all lie outside the
+  // disc or the heights is skipped without reading them.
+  void collect(const Eigen::Vector3d& center, double radius, std::vector<Eigen::Vector3f>& out,
+               double z_min = -INFINITY, double z_max = INFINITY) const;
   size_t leaf_count() const { return leaves_.size(); }
   size_t sample_count() const;
   void clear() { leaves_.clear(); }
@@ -97,7 +101,7 @@ class SurfaceCache {
  private:
   struct LeafSamples {
     std::vector<Eigen::Vector3f> points;
-    Eigen::Vector2f min_xy, max_xy;  // their horizontal bounds
+    Eigen::Vector3f min, max;  // their bounds
   };
   double leaf_size_;  // world size of one leaf (8 voxels)
   std::unordered_map<openvdb::Coord, LeafSamples, CoordHash> leaves_;

@@ -119,12 +119,17 @@ void Open3dTsdf::integrate(const Frame& frame) {
 
 void Open3dTsdf::surface_points(const Eigen::Vector3d& center, double radius,
                                 std::vector<Eigen::Vector3f>& out) const {
+  surface_points_in_band(center, radius, -INFINITY, INFINITY, out);
+}
+
+void Open3dTsdf::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                                        double z_max, std::vector<Eigen::Vector3f>& out) const {
   volume_->refresh_surface(config_.voxel);
   out.clear();
   const Eigen::Vector2f c = center.head<2>().cast<float>();
   const float r2 = static_cast<float>(radius * radius);
   for (const Eigen::Vector3f& p : volume_->samples)
-    if ((p.head<2>() - c).squaredNorm() <= r2) out.push_back(p);
+    if ((p.head<2>() - c).squaredNorm() <= r2 && p.z() >= z_min && p.z() <= z_max) out.push_back(p);
 }
 
 void Open3dTsdf::query(const std::vector<Eigen::Vector3f>& points, std::vector<DistanceQuery>& out) const {

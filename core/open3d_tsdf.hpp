@@ -33,6 +33,8 @@ class Open3dTsdf final : public Mapper {
   // an integrate). Not thread-safe against concurrent calls on the same map.
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const override;
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
   // |TSDF| by trilinear interpolation of Open3D's voxels (at most the truncation), gradient from
   // its derivative; observed only where all 8 neighbouring voxels were.
   void query(const std::vector<Eigen::Vector3f>& points,

@@ -272,6 +272,11 @@ void Tsdf::surface_points(const Eigen::Vector3d& center, double radius,
   fused_.surface_points(center, radius, out);
 }
 
+void Tsdf::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                                 double z_max, std::vector<Eigen::Vector3f>& out) const {
+  fused_.surface_points_in_band(center, radius, z_min, z_max, out);
+}
+
 DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
   DistanceQuery out;
   if (!xf.allFinite()) return out;

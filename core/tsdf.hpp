@@ -45,6 +45,8 @@ class Tsdf final : public Mapper {
   void integrate(const Frame& frame) override;
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const override;
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
   // |TSDF| by trilinear interpolation (at most the truncation), gradient from its derivative;
   // observed only where all 8 neighbouring voxels were.
   void query(const std::vector<Eigen::Vector3f>& points,

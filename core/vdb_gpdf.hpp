@@ -66,6 +66,8 @@ class VdbGpdf final : public Mapper {
   void integrate(const Frame& frame) override;
   void surface_points(const Eigen::Vector3d& center, double radius,
                       std::vector<Eigen::Vector3f>& out) const override;
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
   // Unsigned distance from the global field (smooth minimum over the nearest global GPs).
   void query(const std::vector<Eigen::Vector3f>& points,
              std::vector<DistanceQuery>& out) const override;

@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 
 namespace sonomap::harness {
 
-SweepMaker::SweepMaker(fs::path dir, fs::path brir_dir, bool quiet)
-    : dir_(std::move(dir)), brir_dir_(std::move(brir_dir)), quiet_(quiet) {}
+SweepMaker::SweepMaker(fs::path dir, fs::path brir_dir, double room_radius, bool quiet)
+    : dir_(std::move(dir)), brir_dir_(std::move(brir_dir)), room_radius_(room_radius), quiet_(quiet) {}
 
 SweepMaker::~SweepMaker() = default;
 
@@ -37,7 +37,9 @@ void SweepMaker::make_renderer(const FrameView& frame) {
     brirs = load_brirs(setup, quiet_);
   } else {
     const RasterOrigin& o = frame.origin;
-    const audio::ShoeboxRoom box = audio::room_from_map(*frame.surface, o.position, o.ground_z);
+    std::vector<Eigen::Vector3f> surface;  // all heights: the room's floor and ceiling too
+    frame.map->surface_points(o.position, room_radius_, surface);
+    const audio::ShoeboxRoom box = audio::room_from_map(surface, o.position, o.ground_z);
     audio::BrirSynthConfig room =
         room_from_box(box.min_corner, box.max_corner, o.position, setup.room.rt60);
     room.listener_heading_deg = o.heading * 180.0 / M_PI;
@@ -59,7 +61,7 @@ FrameOutputs::FrameOutputs(const fs::path& dir, const RunOptions& options,
                            std::string mapper_name, const RasterConfig& raster)
     : pictures_(dir / "pictures"), schedule_(schedule), scenario_name_(std::move(scenario_name)),
       mapper_name_(std::move(mapper_name)), raster_(raster),
-      sweeps_(dir / "sweeps", options.brir_dir, options.quiet) {
+      sweeps_(dir / "sweeps", options.brir_dir, raster.max_range, options.quiet) {
   if (schedule.any_pictures()) fs::create_directory(pictures_);
   if (schedule.any_sweeps()) fs::create_directory(dir / "sweeps");
 }

@@ -23,7 +23,9 @@ namespace sonomap::harness {
 // room from the map around the listener (audio/room_from_map.hpp), recorded in room.json.
 class SweepMaker {
  public:
-  SweepMaker(std::filesystem::path dir, std::filesystem::path brir_dir, bool quiet);
+  // Without a BRIR folder, the room is measured from the map's surface within room_radius
+  // (horizontal) of the first swept frame's listener.
+  SweepMaker(std::filesystem::path dir, std::filesystem::path brir_dir, double room_radius, bool quiet);
   ~SweepMaker();
   // dir/frame_NNNNNN.wav and its event log: the circular ranging of the frame's circle.
   void write(const FrameView& frame);
@@ -32,6 +34,7 @@ class SweepMaker {
  private:
   void make_renderer(const FrameView& frame);
   std::filesystem::path dir_, brir_dir_;
+  double room_radius_;
   bool quiet_;
   std::unique_ptr<audio::SweepRenderer> renderer_;
   std::vector<SweepLevel> levels_;

@@ -139,7 +139,7 @@ RunOutcome run_scenario(const RunOptions& options) {
       eval::FrameEvaluation evaluation = evaluate(inputs, *mapper, sensed, rasteriser, with_edf, times);
       if (moved) track_moved_ghosts(*moved, inputs, sensed, rasteriser, evaluation, times);
       const FrameView view{i, sensed.frame.time, origin, &rasteriser.circle(),
-                           &rasteriser.cylinder(), &surface, &evaluation};
+                           &rasteriser.cylinder(), &surface, mapper.get(), &evaluation};
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
       outputs.write(view);
       if (listen) listen->add(view);

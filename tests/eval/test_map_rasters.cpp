@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Rasters from the map against the exact ground truth, on scenes built here: the map must hold
 // what one camera view cannot (a full circle after a turn) and forget what has gone.
+#include "core/depth_only.hpp"
+#include "core/open3d_tsdf.hpp"
+#include "core/rasterise_map.hpp"
 #include "core/rasteriser.hpp"
 #include "core/tsdf.hpp"
 #include "core/vdb_gpdf.hpp"
@@ -14,6 +17,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <memory>
 
 using namespace sonomap;
 
@@ -90,6 +94,15 @@ Evaluation map_full_turn(Mapper& mapper, sim::NoiseSpec::Model noise) {
   return evaluate(mapper, s, frame);
 }
 
+// Cells whose range or point differ (unknown cells are alike whatever their point).
+size_t differing_cells(const std::vector<RasterCell>& a, const std::vector<RasterCell>& b) {
+  REQUIRE(a.size() == b.size());
+  size_t n = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    n += a[i].range != b[i].range || (a[i].known() && a[i].point != b[i].point);
+  return n;
+}
+
 }  // namespace
 
 TEST_CASE("after a full turn in a room the VDB-GPDF circle covers every bin within half a voxel",
@@ -124,4 +137,51 @@ TEST_CASE("after a full turn the TSDF peer's circle covers every bin within one 
   INFO("circle coverage " << e.circle.coverage << ", RMSE off silhouette edges " << e.circle.rmse_off_edges);
   CHECK(e.circle.coverage == 1.0);
   CHECK(e.circle.rmse_off_edges < 0.05);
+}
+
+TEST_CASE("asked for a band of heights, every map leaves out the floor and the walls above it and "
+          "nothing else", "[map][raster][band]") {
+  const sim::Scenario s = turning_in_a_room(sim::NoiseSpec::Model::None);
+  sim::Simulation simulation(s);
+  std::vector<std::unique_ptr<Mapper>> maps;
+  maps.push_back(std::make_unique<VdbGpdf>());
+  maps.push_back(std::make_unique<Tsdf>());
+  maps.push_back(std::make_unique<Open3dTsdf>());
+  maps.push_back(std::make_unique<DepthOnlyMapper>());
+  Frame frame;
+  for (int i = 0; i <= 45; i += 5) {  // half a turn
+    frame = simulation.render(i);
+    for (auto& map : maps) map->integrate(frame);
+  }
+  const RasterConfig config;
+  const RasterOrigin origin = raster_origin(frame.world_T_body, s.ground_z);
+  for (const auto& map : maps) {
+    INFO(map->name());
+    std::vector<Eigen::Vector3f> all, band;
+    map->surface_points(origin.position, config.max_range, all);
+    // The whole surface has the floor (z = 0) and the walls up to where the camera, tilted
+    // down, stops seeing them (about 1.8 m).
+    const auto lowest = std::min_element(all.begin(), all.end(), [](auto& a, auto& b) { return a.z() < b.z(); });
+    const auto highest = std::max_element(all.begin(), all.end(), [](auto& a, auto& b) { return a.z() < b.z(); });
+    REQUIRE(lowest != all.end());
+    CHECK(lowest->z() < 0.05);
+    CHECK(highest->z() > 1.7);
+    // A band from 1.0 to 1.2 m holds the walls' and the box's samples at those heights, in the
+    // same order, and only those.
+    map->surface_points_in_band(origin.position, config.max_range, 1.0, 1.2, band);
+    std::vector<Eigen::Vector3f> expected;
+    for (const Eigen::Vector3f& p : all)
+      if (p.z() >= 1.0 && p.z() <= 1.2) expected.push_back(p);
+    CHECK(expected.size() > 100);
+    CHECK(band == expected);
+    // The rasters built from the band are the rasters of the whole surface, cell for cell.
+    Rasteriser from_band(config), from_all(config);
+    std::vector<Eigen::Vector3f> scratch;
+    rasterise_map(*map, origin, from_band, scratch);
+    from_all.reset(origin);
+    from_all.add(all);
+    CHECK(scratch.size() < all.size());
+    CHECK(differing_cells(from_band.circle().bins, from_all.circle().bins) == 0);
+    CHECK(differing_cells(from_band.cylinder().cells, from_all.cylinder().cells) == 0);
+  }
 }

@@ -69,6 +69,22 @@ TEST_CASE("the depth-only circle in the room covers about one camera view, well 
   CHECK(cylinder < 0.20);
 }
 
+TEST_CASE("a sweep's room reaches up to the ceiling the camera saw, though the rasters stop at 2 m",
+          "[run][sweep]") {
+  // The smoke room is 2.5 m high. Looking 20 degrees up from 1.5 m, the camera sees the
+  // ceiling; the room of the sweep is the map's bounding box, grown to at least 2.4 m.
+  ScratchDir scratch("run-sweep-room");
+  auto o = sonomap::test::smoke_run(scratch.path() / "out", "depth_only", 2);
+  o.overrides.push_back("sensor.mounting.pitch=-20");
+  o.sweep_frames = {};  // the last frame
+  sonomap::harness::run_scenario(o);
+  std::ifstream in(o.out / "sweeps" / "room.json");
+  const json room = json::parse(in);
+  CHECK(room["min_corner"][2].get<double>() == Approx(0.0).margin(1e-9));  // the ground
+  CHECK(room["max_corner"][2].get<double>() > 2.45);
+  CHECK(room["max_corner"][2].get<double>() < 2.6);  // the highest of many noisy ceiling points
+}
+
 TEST_CASE("results are byte-identical across reruns and across 1 and 2 threads", "[run][determinism]") {
   ScratchDir scratch("run-determinism");
   std::vector<fs::path> dirs;
