@@ -9,6 +9,9 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 namespace sonomap {
 
 namespace {
@@ -26,7 +29,7 @@ constexpr size_t kBatch = 256;
 
 struct Batch {
   double x[kBatch], y[kBatch], z[kBatch];  // the points, in the world
-  double range2[kBatch];                   // squared horizontal range
+  float range[kBatch];                     // the horizontal range a cell records
   double bin_position[kBatch];             // fast atan2 / bin width, in [0, bins]
   double row_position[kBatch];             // (height - band_min) / row height
   int64_t counts[kBatch];                  // in the band and the range (0 if not finite)
@@ -66,7 +69,7 @@ SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement
     const double signed_position = a3 * at.bins_per_radian, wrapped = signed_position + at.bins;
     const double position = signed_position < 0.0 ? wrapped : signed_position;
     const double above_edge = position - std::floor(position);
-    b.range2[i] = range2;
+    b.range[i] = static_cast<float>(std::sqrt(range2));  // vectorised: cheaper than one by one
     b.bin_position[i] = position;
     b.row_position[i] = (height - at.band_min) / at.row_height;
     b.near_edge[i] = (above_edge <= at.margin_bins) | (above_edge >= 1.0 - at.margin_bins);
@@ -76,15 +79,6 @@ SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement
 void locate_baseline(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
 SONOMAP_AVX2_KERNEL void locate_avx2(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
 SONOMAP_AVX512_KERNEL void locate_avx512(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
-
-// Whether a sample at squared range `range2` may be nearer than what `cell` holds. The cell
-// takes it when float(sqrt(range2)) < cell.range; range2 >= cell.range^2 (exact in double for
-// a float) rules that out without the square root, and most samples are not their cell's
-// nearest.
-bool may_be_nearer(double range2, const RasterCell& cell) {
-  const double held = cell.range;
-  return range2 < held * held;
-}
 
 }  // namespace
 
@@ -114,16 +108,13 @@ void Rasteriser::reset(const RasterOrigin& origin) {
   cells_.clear();
 }
 
-inline void Rasteriser::place(Cells& cells, const Eigen::Vector3f& point, double range2, int bin, int row) {
+inline void Rasteriser::place(Cells& cells, const Eigen::Vector3f& point, float range, int bin, int row) {
   RasterCell& cell = cells.circle.bins[static_cast<size_t>(bin)];
-  RasterCell* cyl_cell = row < cells.cylinder.rows ? &cells.cylinder.at(row, bin) : nullptr;
-  // The circle's cell is never farther than a cylinder cell of its bin, so a sample that
-  // cannot beat the circle may still beat the cylinder: test both.
-  if (!may_be_nearer(range2, cell) && !(cyl_cell && may_be_nearer(range2, *cyl_cell))) return;
-
-  const auto range = static_cast<float>(std::sqrt(range2));
   if (range < cell.range) cell = RasterCell{range, point};
-  if (cyl_cell && range < cyl_cell->range) *cyl_cell = RasterCell{range, point};
+  if (row < cells.cylinder.rows) {
+    RasterCell& cyl_cell = cells.cylinder.at(row, bin);
+    if (range < cyl_cell.range) cyl_cell = RasterCell{range, point};
+  }
 }
 
 inline int Rasteriser::last_row_fix(int row, const Eigen::Vector3f& point) const {
@@ -152,7 +143,7 @@ void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t coun
       const Eigen::Vector3f& point = points[begin + k];
       // Both positions are in range for a point that counts: the conversions are floors.
       const int bin = b.near_edge[k] ? exact_bin(point) : static_cast<int>(b.bin_position[k]);
-      place(cells, point, b.range2[k], bin, last_row_fix(static_cast<int>(b.row_position[k]), point));
+      place(cells, point, b.range[k], bin, last_row_fix(static_cast<int>(b.row_position[k]), point));
     }
   }
 }
@@ -191,20 +182,25 @@ void Rasteriser::Cells::merge(const Cells& part) {
 void Rasteriser::add(const Eigen::Vector3f* points, std::size_t count) {
   // In every cell a pass in order keeps the first of the nearest points. Each part keeps the
   // first of its own nearest, and merging the parts in order with strict "nearer" picks the
-  // first of those: the same point. The parts depend on the count alone.
-  constexpr size_t kParts = 4, kMinPartPoints = 4096;
-  if (count < kParts * kMinPartPoints) {
+  // first of those: the same point. So the parts change no result and can follow the threads
+  // there are: one thread adds in one pass, without clearing and merging parts.
+  constexpr size_t kMaxParts = 4, kMinPartPoints = 4096;
+  const size_t threads = std::min<size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+      static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency())));
+  const size_t parts = std::clamp<size_t>(threads, 1, kMaxParts);
+  if (parts == 1 || count < parts * kMinPartPoints) {
     add_to(cells_, points, count);
     return;
   }
-  parts_.resize(kParts, cells_);
-  parallel_for_each_index(kParts, [&](size_t part) {
+  parts_.resize(parts, cells_);
+  parallel_for_each_index(parts, [&](size_t part) {
     Cells& cells = parts_[part];
     cells.clear();
-    const size_t begin = part * count / kParts, end = (part + 1) * count / kParts;
+    const size_t begin = part * count / parts, end = (part + 1) * count / parts;
     add_to(cells, points + begin, end - begin);
   });
-  for (const Cells& part : parts_) cells_.merge(part);
+  for (size_t part = 0; part < parts; ++part) cells_.merge(parts_[part]);
 }
 
 }  // namespace sonomap

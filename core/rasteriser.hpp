@@ -33,8 +33,9 @@ class Rasteriser {
   // The cylinder row is floor((z - ground_z - band_min) / row_height); the band's top edge
   // belongs to the last row, heights above the last row's top only reach the circle.
   void add(const Eigen::Vector3f& point) { add_to(cells_, &point, 1); }
-  // The same as adding the points one by one in order, split into fixed parts (so the result
-  // does not depend on the thread count) rasterised in parallel and merged in order.
+  // The same as adding the points one by one in order: with more than one thread, split into
+  // parts (one per thread, at most 4) rasterised in parallel and merged so that every cell
+  // keeps what one pass in order keeps. The result does not depend on the thread count.
   void add(const Eigen::Vector3f* points, std::size_t count);
   void add(const std::vector<Eigen::Vector3f>& points) { add(points.data(), points.size()); }
 
@@ -62,7 +63,7 @@ class Rasteriser {
   };
   void add_to(Cells& cells, const Eigen::Vector3f* points, std::size_t count) const;
   // Puts a counting point in the circle's cell and the cylinder's (row < rows) where nearer.
-  static void place(Cells& cells, const Eigen::Vector3f& point, double range2, int bin, int row);
+  static void place(Cells& cells, const Eigen::Vector3f& point, float range, int bin, int row);
   // The bin of a point as floor(atan2(y, x) / bin width) in the body frame (x ahead, y left),
   // with the edge snapping described at add().
   int exact_bin(const Eigen::Vector3f& point) const;

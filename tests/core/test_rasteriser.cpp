@@ -5,6 +5,8 @@
 #include "core/rasteriser.hpp"
 
 #include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -179,10 +181,14 @@ TEST_CASE("Of points at equal range in one cell the first added stays, also amon
   points[50] = farther_first;
   points[35000] = nearer;
 
-  Rasteriser at_once = at_origin(), one_by_one = at_origin();
-  at_once.add(points);
+  Rasteriser at_once = at_origin(), one_thread = at_origin(), one_by_one = at_origin();
+  at_once.add(points);  // in parts, one per thread, when there are several
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one_thread.add(points);
+  }
   for (const Eigen::Vector3f& p : points) one_by_one.add(p);
-  for (const Rasteriser* r : {&at_once, &one_by_one}) {
+  for (const Rasteriser* r : {&at_once, &one_thread, &one_by_one}) {
     CHECK(r->circle().bins[30].range == Approx(2.5).epsilon(1e-6));
     CHECK(r->circle().bins[30].point == first);
     CHECK(r->cylinder().at(9, 30).point == first);
