@@ -61,10 +61,8 @@ class Mapper {
   // keeps its samples by place can skip the floor and the ceiling without reading them.
   // Returning samples outside the band is allowed (the rasteriser ignores them); dropping one
   // inside is not. The default returns all of surface_points().
-  virtual void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
-                                      double z_max, std::vector<Eigen::Vector3f>& out) const {
-    (void)z_min;
-    (void)z_max;
+  virtual void surface_points_in_band(const Eigen::Vector3d& center, double radius, double /*z_min*/,
+                                      double /*z_max*/, std::vector<Eigen::Vector3f>& out) const {
     surface_points(center, radius, out);
   }
   // Distance field queries (batched, world points): `out` gets exactly one answer per point.
