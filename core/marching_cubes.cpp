@@ -183,7 +183,8 @@ class SampleEmitter {
     vertex_emitted_[v] = true;
     out_.push_back(mesh_.vertices[v]);
   }
-  // The inner points of edge (p, q) divided in n: step s of n from p, for s in (0, n).
+  // The inner points of edge (p, q) divided in n, steps 1 to n - 1 from its lower-numbered
+  // vertex, unless the edge was divided in n before.
   void edge(int p, int q, int n) {
     const int lo = std::min(p, q), hi = std::max(p, q);
     if (!first_division(static_cast<uint64_t>(lo) * mesh_.vertices.size() + static_cast<uint64_t>(hi), n)) return;

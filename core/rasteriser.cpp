@@ -20,9 +20,10 @@ constexpr double kDegreesPerRadian = 180.0 / M_PI;
 constexpr double kAxisRange = 1e-9;      // metres: closer to the vertical axis has no azimuth
 constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at bin edges
 
-// The first pass over a batch of points finds, for each, whether it counts, its squared range,
-// its bin position by a fast arctangent and its row quotient. It is written without branches,
-// over arrays of one type, so that the compiler vectorises it (core/vector_isa.hpp: a copy
+// The first pass over a batch of points finds, for each, whether it counts, its range (the
+// square roots are cheaper eight at a time than one by one in the second pass), its bin
+// position by a fast arctangent and its row quotient. It is written without branches, over
+// plain arrays, so that the compiler vectorises it (core/vector_isa.hpp: a copy
 // per instruction set; the top-level CMakeLists.txt gives the options it needs and why). The second
 // pass, one point at a time, places the points in their cells.
 constexpr size_t kBatch = 256;
@@ -69,7 +70,7 @@ SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement
     const double signed_position = a3 * at.bins_per_radian, wrapped = signed_position + at.bins;
     const double position = signed_position < 0.0 ? wrapped : signed_position;
     const double above_edge = position - std::floor(position);
-    b.range[i] = static_cast<float>(std::sqrt(range2));  // vectorised: cheaper than one by one
+    b.range[i] = static_cast<float>(std::sqrt(range2));
     b.bin_position[i] = position;
     b.row_position[i] = (height - at.band_min) / at.row_height;
     b.near_edge[i] = (above_edge <= at.margin_bins) | (above_edge >= 1.0 - at.margin_bins);
