@@ -3,6 +3,8 @@
 
 #include "core/parallel.hpp"
 
+#include <cmath>
+
 namespace sonomap {
 
 FusedGrid::FusedGrid(double voxel, float min_weight, double weight_cap)
@@ -28,14 +30,13 @@ std::vector<SurfaceMesh> FusedGrid::refresh(const std::vector<openvdb::Coord>& l
 
 void FusedGrid::surface_points(const Eigen::Vector3d& center, double radius,
                                std::vector<Eigen::Vector3f>& out) const {
-  out.clear();
-  cache_.collect(center, radius, out);
+  surface_points_in_band(center, radius, -INFINITY, INFINITY, out);
 }
 
 void FusedGrid::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
                                        double z_max, std::vector<Eigen::Vector3f>& out) const {
   out.clear();
-  cache_.collect(center, radius, out, z_min, z_max);
+  cache_.collect(center, radius, z_min, z_max, out);
 }
 
 void FusedGrid::surface_mesh(std::vector<Eigen::Vector3f>& vertices,

@@ -294,8 +294,8 @@ void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vec
   leaf.points = std::move(samples);
 }
 
-void SurfaceCache::collect(const Eigen::Vector3d& center, double radius,
-                           std::vector<Eigen::Vector3f>& out, double z_min, double z_max) const {
+void SurfaceCache::collect(const Eigen::Vector3d& center, double radius, double z_min,
+                           double z_max, std::vector<Eigen::Vector3f>& out) const {
   if (leaves_.empty() || !(radius >= 0.0)) return;
   const int x0 = static_cast<int>(std::floor((center.x() - radius) / leaf_size_)) * kLeafDim;
   const int x1 = static_cast<int>(std::floor((center.x() + radius) / leaf_size_)) * kLeafDim;

@@ -12,7 +12,6 @@
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
-#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -92,8 +91,8 @@ class SurfaceCache {
   // Appends the samples within horizontal distance `radius` of center whose height z lies in
   // [z_min, z_max], leaf by leaf in a fixed order; a leaf whose samples all lie outside the
   // disc or the heights is skipped without reading them.
-  void collect(const Eigen::Vector3d& center, double radius, std::vector<Eigen::Vector3f>& out,
-               double z_min = -INFINITY, double z_max = INFINITY) const;
+  void collect(const Eigen::Vector3d& center, double radius, double z_min, double z_max,
+               std::vector<Eigen::Vector3f>& out) const;
   size_t leaf_count() const { return leaves_.size(); }
   size_t sample_count() const;
   void clear() { leaves_.clear(); }
