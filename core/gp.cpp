@@ -110,7 +110,12 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
   for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha_[i]);
 }
 
-GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance) const {
+GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance, bool with_gradient) const {
+  return with_gradient ? predict_as<true>(x, with_variance) : predict_as<false>(x, with_variance);
+}
+
+template <bool kGradient>
+GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance) const {
   GpPrediction out;
   const size_t n = points_.size();
   if (n == 0) return out;
@@ -137,16 +142,18 @@ GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance) co
     top = e > top ? e : top;
   }
   const float max_expo = lane_max(top);
-  Floats f = {}, gx = {}, gy = {}, gz = {};  // f and grad f / (-rate), per lane
+  Floats f = {};
+  [[maybe_unused]] Floats gx = {}, gy = {}, gz = {};  // f and grad f / (-rate), per lane
   for (size_t i = 0; i < padded; i += kLanes) {
     Floats w = load(&alpha_lanes_[i]) * exp_nonpositive(load(&expo[i]) - max_expo);
-    gx += w * (qx - load(&xs_[i]));
-    gy += w * (qy - load(&ys_[i]));
-    gz += w * (qz - load(&zs_[i]));
+    if constexpr (kGradient) {
+      gx += w * (qx - load(&xs_[i]));
+      gy += w * (qy - load(&ys_[i]));
+      gz += w * (qz - load(&zs_[i]));
+    }
     f += se ? w : w * (1.0f + rate * load(&radius[i]));
   }
   const double s = lane_sum(f);
-  const Eigen::Vector3d g = -(se ? a_ : a_ * a_) * Eigen::Vector3d(lane_sum(gx), lane_sum(gy), lane_sum(gz));
   if (!std::isfinite(s)) return out;
   if (!(s > 0.0)) {
     // Far from the points the nearest one dominates, and a negative weight there makes the
@@ -157,15 +164,18 @@ GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance) co
     for (size_t i = 1; i < n; ++i)
       if (radius[i] < radius[nearest]) nearest = i;
     out.distance = se ? std::sqrt(static_cast<double>(radius[nearest])) : static_cast<double>(radius[nearest]);
-    if (out.distance > 0.0) out.gradient = (x - points_[nearest].cast<double>()) / out.distance;
+    if (kGradient && out.distance > 0.0) out.gradient = (x - points_[nearest].cast<double>()) / out.distance;
     out.variance = params_.variance_cap;
     out.valid = true;
     return out;
   }
   const double log_f = static_cast<double>(max_expo) + std::log(s);
   out.distance = se ? std::sqrt(2.0 * std::abs(log_f) / a_) : std::abs(log_f) / a_;
-  const double gn = g.norm();
-  if (gn > 0.0 && std::isfinite(gn)) out.gradient = -g / gn;
+  if constexpr (kGradient) {
+    const Eigen::Vector3d g = -(se ? a_ : a_ * a_) * Eigen::Vector3d(lane_sum(gx), lane_sum(gy), lane_sum(gz));
+    const double gn = g.norm();
+    if (gn > 0.0 && std::isfinite(gn)) out.gradient = -g / gn;
+  }
   out.valid = std::isfinite(out.distance);
   if (with_variance && out.valid) {
     Eigen::VectorXd kstar(n);

@@ -208,7 +208,7 @@ struct LocalGps {
   GpPrediction smallest(const Eigen::Vector3d& q, bool with_variance) const {
     GpPrediction best;
     auto consider = [&](int i) {
-      const GpPrediction p = gps[i].predict(q, with_variance);
+      const GpPrediction p = gps[i].predict(q, with_variance, false);
       if (p.valid && (!best.valid || p.distance < best.distance)) best = p;
     };
     Around around;
@@ -549,7 +549,7 @@ class LeafQueries {
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
     // inward, as the first-order value at the centre: -d(p) - facing . (centre - p).
-    const GpPrediction at_p = gp_.predict(p, false);  // p lies in this leaf: its GP is the nearest
+    const GpPrediction at_p = gp_.predict(p, false, false);  // p lies in this leaf: its GP is the nearest
     const double d = at_p.valid ? at_p.distance : 0.0;
     votes.push_back({own, kSurface, static_cast<float>(-d - facing.dot(voxel_centre(own, vg_) - p))});
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
@@ -893,7 +893,7 @@ DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
   for (const auto& [d2, leaf] : found) {
     if (d2 > reach * reach) continue;
     std::call_once(leaf->trained, [&, leaf = leaf] { leaf->gp.train(leaf->crossings, config_.global_gp_params()); });
-    GpPrediction p = leaf->gp.predict(x, true);
+    GpPrediction p = leaf->gp.predict(x, true, false);  // the gradient comes from all crossings
     if (!p.valid) continue;
     d_min = std::min(d_min, p.distance);
     preds.push_back(p);
