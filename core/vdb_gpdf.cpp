@@ -747,16 +747,7 @@ struct VdbGpdf::GlobalLeaf {
   std::vector<Eigen::Vector3f> crossings;
   mutable std::once_flag trained;
   mutable SurfaceGp gp;
-  mutable std::atomic<uint64_t> queried_after{0};  // the map's frames_ at its latest query
 };
-
-namespace {
-// Records `frames` in a counter that parallel queries share: written only when it changes,
-// so the threads do not take its cache line from each other on every query.
-void note_query(std::atomic<uint64_t>& at, uint64_t frames) {
-  if (at.load(std::memory_order_relaxed) != frames) at.store(frames, std::memory_order_relaxed);
-}
-}  // namespace
 
 void VdbGpdfConfig::validate() const {
   auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
@@ -814,8 +805,6 @@ VdbGpdf::~VdbGpdf() = default;
 
 void VdbGpdf::integrate(const Frame& frame) {
   check_pose(frame);
-  forget_unused_global_gps();
-  ++frames_;
   times_.stages.clear();
   const auto t_start = Clock::now();
   const Eigen::Vector3d origin = frame.world_T_camera.translation();
@@ -851,19 +840,6 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
     leaf->centre = leaf_centre(dirty[i], config_.global_voxel);
     leaf->crossings = std::move(meshes[i].vertices);
     global_[dirty[i]] = std::move(leaf);
-  }
-}
-
-void VdbGpdf::forget_unused_global_gps() {
-  const uint64_t latest = queried_after_.load();
-  if (latest == forgotten_after_) return;  // no query since: nothing has newly gone unused
-  forgotten_after_ = latest;
-  for (auto& [origin, leaf] : global_) {
-    if (!leaf->gp.trained() || leaf->queried_after.load() >= latest) continue;
-    auto untrained = std::make_unique<GlobalLeaf>();  // a fresh once_flag: trained again when asked
-    untrained->centre = leaf->centre;
-    untrained->crossings = std::move(leaf->crossings);
-    leaf = std::move(untrained);
   }
 }
 
@@ -914,10 +890,8 @@ DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
   double d_min = std::numeric_limits<double>::infinity();
   std::vector<GpPrediction> preds;
   std::vector<const GlobalLeaf*> used;
-  note_query(queried_after_, frames_);
   for (const auto& [d2, leaf] : found) {
     if (d2 > reach * reach) continue;
-    note_query(leaf->queried_after, frames_);
     std::call_once(leaf->trained, [&, leaf = leaf] { leaf->gp.train(leaf->crossings, config_.global_gp_params()); });
     GpPrediction p = leaf->gp.predict(x, true, false);  // the gradient comes from all crossings
     if (!p.valid) continue;

@@ -11,8 +11,6 @@
 #include "core/mapper.hpp"
 #include "core/marching_cubes.hpp"
 
-#include <atomic>
-#include <cstdint>
 #include <memory>
 #include <unordered_map>
 
@@ -90,19 +88,12 @@ class VdbGpdf final : public Mapper {
   // refreshes their surface samples and, for leaves with enough touched voxels, their
   // global GP training points (or drops the GP when the leaf has no zero crossing).
   void update_global_field(const DistanceWeightGrid& frame_sums);
-  // Frees the global GPs that the latest frame with queries did not use (the listener has
-  // moved on). Training is deterministic, so one retrained later is the same to the bit; a
-  // 2700-frame room otherwise kept the GPs of every leaf ever queried, 19 MB at its end.
-  void forget_unused_global_gps();
   Eigen::Vector3d soft_nearest_direction(const Eigen::Vector3d& x,
                                          const std::vector<const GlobalLeaf*>& leaves) const;
 
   VdbGpdfConfig config_;
   FusedGrid fused_;
   std::unordered_map<openvdb::Coord, std::unique_ptr<GlobalLeaf>, CoordHash> global_;
-  uint64_t frames_ = 0;                             // frames integrated
-  mutable std::atomic<uint64_t> queried_after_{0};  // frames_ at the latest query
-  uint64_t forgotten_after_ = 0;                    // queried_after_ at the latest forgetting
   StageTimes times_;
 };
 

@@ -201,52 +201,6 @@ TEST_CASE("VDB-GPDF: two runs and 1 vs 2 threads give identical surfaces and que
   CHECK(a == c);
 }
 
-TEST_CASE("VDB-GPDF: the global GPs that queries stop using are freed, and come back the same to the bit",
-          "[vdb_gpdf][memory]") {
-  const auto poses = test::orbit(Eigen::Vector3d(0.0, 0.0, 0.25), 1.5, 1.0, 12);
-  auto integrate = [&](VdbGpdf& map, size_t from, size_t to) {
-    for (size_t i = from; i < to; ++i) map.integrate(test::render(box_scene(), poses[i], static_cast<int>(i)));
-  };
-  auto ask = [](const VdbGpdf& map, const std::vector<Eigen::Vector3f>& at) {
-    std::vector<DistanceQuery> q;
-    map.query(at, q);
-    return q;
-  };
-  std::vector<Eigen::Vector3f> around_box;
-  for (const auto& p : box_probes(0.1)) around_box.push_back(p.point.cast<float>());
-  const std::vector<Eigen::Vector3f> one_corner{Eigen::Vector3f(0.4f, 0.4f, 0.6f)};
-
-  VdbGpdf moved_on, only_corner;  // the same frames; the first was also asked all around the box
-  integrate(moved_on, 0, 10);
-  integrate(only_corner, 0, 10);
-  ask(moved_on, around_box);
-  integrate(moved_on, 10, 11);
-  integrate(only_corner, 10, 11);
-  ask(moved_on, one_corner);
-  ask(only_corner, one_corner);
-  const size_t holding_all = moved_on.memory_bytes();
-  INFO("bytes: holding every GP " << holding_all << ", only the corner's " << only_corner.memory_bytes());
-  REQUIRE(holding_all > only_corner.memory_bytes());  // the GPs trained around the box
-  integrate(moved_on, 11, 12);  // the latest query used only the corner's GPs: the rest go
-  integrate(only_corner, 11, 12);
-  CHECK(moved_on.memory_bytes() == only_corner.memory_bytes());
-
-  VdbGpdf never_asked;
-  integrate(never_asked, 0, 12);
-  const auto expected = ask(never_asked, around_box);
-  for (const VdbGpdf* map : {&moved_on, &only_corner}) {
-    const auto got = ask(*map, around_box);
-    REQUIRE(got.size() == expected.size());
-    for (size_t i = 0; i < got.size(); ++i) {
-      INFO("probe " << i);
-      CHECK(got[i].observed == expected[i].observed);
-      CHECK(got[i].distance == expected[i].distance);  // bit for bit
-      CHECK(got[i].variance == expected[i].variance);
-      CHECK(got[i].gradient == expected[i].gradient);
-    }
-  }
-}
-
 TEST_CASE("VDB-GPDF: bad input is rejected or skipped, never fused", "[vdb_gpdf][bad_input]") {
   const auto poses = test::orbit(Eigen::Vector3d(0.0, 0.0, 0.25), 1.5, 1.0, 4);
   auto surface = [](const VdbGpdf& m) {
