@@ -45,7 +45,7 @@ class SurfaceGp {
   // Distance, gradient (grad d = -grad f / |grad f|) and, if asked, variance at x.
   // f is evaluated relative to its largest kernel term, so far from the points the distance
   // stays finite instead of underflowing to "f = 0". Without with_gradient the gradient is
-  // left zero (the mapper's per-frame queries need only distances: a fifth of the work).
+  // left zero and not computed (the mapper's per-frame queries need only distances).
   GpPrediction predict(const Eigen::Vector3d& x, bool with_variance, bool with_gradient = true) const;
 
  private:

@@ -15,7 +15,7 @@ namespace sonomap {
 // (Amanatides and Woo), with openvdb::math::DDA's arithmetic to the bit (its ties included).
 // DDA keeps the cell in a Coord that it steps along an axis chosen at run time; reading that
 // Coord back right after the 4-byte store stalled store-to-load forwarding, one instruction
-// taking 8% of the carving's samples. Here each axis is a variable of its own.
+// taking 8% of the samples of VDB-GPDF's per-source loop. Here each axis is a variable of its own.
 template <int Log2Dim>
 class GridWalk {
  public:

@@ -118,12 +118,12 @@ class DepthView {
   bool usable_;
 };
 
-// The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
-// one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
-// of its 26 neighbours; else the nearest of all (rare: points far from every surface).
 constexpr size_t kLeafLog2 = DistanceWeightGrid::TreeType::LeafNodeType::LOG2DIM;  // kLeafDim = 2^3
 static_assert(1 << kLeafLog2 == kLeafDim);
 
+// The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
+// one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
+// of its 26 neighbours; else the nearest of all (rare: points far from every surface).
 struct LocalGps {
   double voxel = 0.02;
   std::vector<openvdb::Coord> origins;
@@ -230,7 +230,7 @@ Eigen::Vector3d centroid(const openvdb::Vec4f& sum) {
 }
 
 // The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
-// centroids of the occupied local voxels within two voxels of p's (up to 125, about 25 on a
+// centroids of the occupied local voxels within two voxels of p's (up to 57, about 25 on a
 // plane). Returns zero where the neighbourhood is too small for a plane.
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
