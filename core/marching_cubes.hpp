@@ -39,11 +39,19 @@ struct CoordHash {
   }
 };
 
-constexpr int kLeafDim = DistanceWeightGrid::TreeType::LeafNodeType::DIM;  // 8
+constexpr int kLeafLog2 = DistanceWeightGrid::TreeType::LeafNodeType::LOG2DIM;  // 3
+constexpr int kLeafDim = 1 << kLeafLog2;                                         // 8
 
 // The leaf origin (index space) of the leaf holding voxel ijk.
 inline openvdb::Coord leaf_origin_of(const openvdb::Coord& ijk) {
   return ijk & ~(kLeafDim - 1);
+}
+
+// The leaf holding voxel ijk as one cell of a grid with one value per leaf (the origin over
+// kLeafDim), and back.
+inline openvdb::Coord leaf_key_of(const openvdb::Coord& ijk) { return ijk >> kLeafLog2; }
+inline openvdb::Coord leaf_origin_of_key(const openvdb::Coord& key) {  // no << : keys may be negative
+  return openvdb::Coord(key.x() * kLeafDim, key.y() * kLeafDim, key.z() * kLeafDim);
 }
 
 // Index-space voxel holding world point p (floor binning).

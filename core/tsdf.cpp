@@ -128,7 +128,7 @@ void mark_leaves_in_view(const DistanceWeightGrid& grid, const DepthImage& image
     const openvdb::Coord o = leaf->origin();
     const Eigen::Vector3d centre = Eigen::Vector3d(o.x(), o.y(), o.z()) * voxel + Eigen::Vector3d::Constant(half);
     if (image.may_see(camera_T_world * centre, radius, reach))
-      acc.setValueOn(openvdb::Coord(o.x() / kLeafDim, o.y() / kLeafDim, o.z() / kLeafDim));
+      acc.setValueOn(leaf_key_of(o));
   }
 }
 
@@ -210,7 +210,7 @@ std::vector<LeafChanges> Tsdf::integrate_image(const Frame& frame) {
   std::vector<bool> created;
   for (auto b = blocks_.cbeginValueOn(); b; ++b) {
     const openvdb::Coord c = b.getCoord();
-    const openvdb::Coord origin(c.x() * kLeafDim, c.y() * kLeafDim, c.z() * kLeafDim);
+    const openvdb::Coord origin = leaf_origin_of_key(c);
     Leaf* leaf = tree.probeLeaf(origin);
     created.push_back(leaf == nullptr);
     leaves.push_back(leaf ? leaf : tree.touchLeaf(origin));

@@ -118,9 +118,6 @@ class DepthView {
   bool usable_;
 };
 
-constexpr size_t kLeafLog2 = DistanceWeightGrid::TreeType::LeafNodeType::LOG2DIM;  // kLeafDim = 2^3
-static_assert(1 << kLeafLog2 == kLeafDim);
-
 // The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
 // one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
 // of its 26 neighbours; else the nearest of all (rare: points far from every surface).
@@ -134,8 +131,6 @@ struct LocalGps {
   // because an accessor finds the 26 neighbours of a leaf mostly in the node it has cached.
   openvdb::Int32Tree index{-1};
   using IndexAccessor = openvdb::tree::ValueAccessor<const openvdb::Int32Tree, false>;  // unregistered: per call
-
-  static openvdb::Coord index_key(const openvdb::Coord& leaf_origin) { return leaf_origin >> kLeafLog2; }
   std::vector<std::vector<int>> neighbours;  // per leaf, its neighbouring leaves (of 26)
 
   // Once every leaf is indexed: most queries lie in a leaf, and then smallest() reads its
@@ -151,7 +146,7 @@ struct LocalGps {
   // Calls f(index) for every leaf among the 26 around the leaf at `home`.
   template <typename F>
   void for_each_neighbour(const IndexAccessor& at, const openvdb::Coord& home, F&& f) const {
-    const openvdb::Coord key = index_key(home);
+    const openvdb::Coord key = leaf_key_of(home);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
@@ -175,7 +170,7 @@ struct LocalGps {
   int nearest(const Eigen::Vector3d& q, Around& around) const {
     const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
     const IndexAccessor at(index);
-    if (const int own = at.getValue(index_key(home)); own >= 0) {
+    if (const int own = at.getValue(leaf_key_of(home)); own >= 0) {
       around.begin = neighbours[own].data();
       around.end = around.begin + neighbours[own].size();
       return own;
@@ -460,7 +455,7 @@ std::vector<LeafCells> index_local_leaves(const VdbGpdfConfig& config, LocalFram
     gps.origins[i] = leaves[i]->origin();
     gps.centres[i] = leaf_centre(gps.origins[i], config.local_voxel);
   });
-  for (size_t i = 0; i < n; ++i) gps.index.setValue(LocalGps::index_key(gps.origins[i]), static_cast<int>(i));
+  for (size_t i = 0; i < n; ++i) gps.index.setValue(leaf_key_of(gps.origins[i]), static_cast<int>(i));
   gps.link_neighbours();
   return cells;
 }

@@ -8,7 +8,7 @@
 #include <openvdb/math/Ray.h>
 
 #include <catch2/catch.hpp>
-#include <cstdint>
+#include <random>
 #include <vector>
 
 using namespace sonomap;
@@ -41,15 +41,9 @@ std::vector<Step> openvdb_walk(const Eigen::Vector3d& eye, const Eigen::Vector3d
   return steps;
 }
 
-// Reproducible values in [-1, 1) from a 64-bit linear congruential generator (the same on
-// every standard library).
-struct Lcg {
-  uint64_t state;
-  double next() {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(state >> 11) / static_cast<double>(1ull << 52) - 1.0;
-  }
-};
+// Reproducible values in [-1, 1): std::mt19937_64's output is fixed by the standard (its
+// distributions are not, so none is used).
+double signed_unit(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) / (1ull << 52) - 1.0; }
 
 }  // namespace
 
@@ -77,17 +71,17 @@ TEST_CASE("A ray along -y through 8-voxel blocks enters each block at its face, 
 
 TEST_CASE("Any ray walks the cells, entry times and exits of openvdb's DDA to the bit, ties included",
           "[grid_walk]") {
-  Lcg random{20261127};
+  std::mt19937_64 rng(20261127);
   for (int i = 0; i < 2000; ++i) {
-    Eigen::Vector3d eye(random.next() * 40.0, random.next() * 40.0, random.next() * 40.0);
-    Eigen::Vector3d dir(random.next(), random.next(), random.next());
+    Eigen::Vector3d eye(signed_unit(rng) * 40.0, signed_unit(rng) * 40.0, signed_unit(rng) * 40.0);
+    Eigen::Vector3d dir(signed_unit(rng), signed_unit(rng), signed_unit(rng));
     if (i % 4 == 1) eye = eye.array().round();  // starting on cell corners and faces
     if (i % 5 == 2) dir[i % 3] = 0.0;           // parallel to one axis
     if (i % 7 == 3) dir = Eigen::Vector3d(1.0, -1.0, 1.0);  // through edges and corners: ties
     if (dir.isZero()) dir.x() = 1.0;
     dir.normalize();
-    const double t0 = i % 3 == 0 ? 0.0 : std::abs(random.next()) * 5.0;
-    const double t1 = t0 + std::abs(random.next()) * 60.0;
+    const double t0 = i % 3 == 0 ? 0.0 : std::abs(signed_unit(rng)) * 5.0;
+    const double t1 = t0 + std::abs(signed_unit(rng)) * 60.0;
     INFO("ray " << i);
     CHECK(walk<0>(eye, dir, t0, t1) == openvdb_walk<0>(eye, dir, t0, t1));
     CHECK(walk<3>(eye, dir, t0, t1) == openvdb_walk<3>(eye, dir, t0, t1));
