@@ -16,7 +16,7 @@ static const BrirSet& checked(const std::shared_ptr<const BrirSet>& brirs) {
 BrirConvolver::BrirConvolver(std::shared_ptr<const BrirSet> brirs, size_t max_sound_length)
     : brirs_(std::move(brirs)),
       max_sound_length_(max_sound_length),
-      fft_(next_power_of_two(std::max<size_t>(2, max_sound_length + checked(brirs_).ir_length()))),
+      fft_(next_fast_size(max_sound_length + checked(brirs_).ir_length())),
       cache_(brirs_->distance_count() * brirs_->azimuth_count() * 2) {}
 
 size_t BrirConvolver::key(size_t d, size_t a, Ear ear) const {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "audio/fft.hpp"
 
+#include <algorithm>
+
 #include <fftw3.h>
 #include <map>
 #include <mutex>
@@ -16,6 +18,15 @@ size_t next_power_of_two(size_t n) {
   size_t p = 1;
   while (p < n) p <<= 1;
   return p;
+}
+
+size_t next_fast_size(size_t n) {
+  size_t best = next_power_of_two(std::max<size_t>(n, 2));
+  for (size_t p2 = 2; p2 < best; p2 *= 2)
+    for (size_t p3 = p2; p3 < best; p3 *= 3)
+      for (size_t p5 = p3; p5 < best; p5 *= 5)
+        if (p5 >= n) best = p5;
+  return best;
 }
 
 namespace {

@@ -54,5 +54,8 @@ class RealFft {
 
 // Smallest power of two >= n.
 size_t next_power_of_two(size_t n);
+// The smallest even size >= n with no prime factor above 5 (FFTW transforms these about as
+// fast as powers of two, and they pad far less: 34,000 samples take 34,560, not 65,536).
+size_t next_fast_size(size_t n);
 
 }  // namespace sonomap::audio

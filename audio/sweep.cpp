@@ -307,6 +307,37 @@ size_t SweepRenderer::period_samples() const {
   return static_cast<size_t>(std::ceil(config_.period_s * config_.sample_rate));
 }
 
+void SweepRenderer::convolve_block(const std::vector<SweepEvent>& events,
+                                   const std::vector<std::pair<size_t, size_t>>& pairs, size_t first,
+                                   size_t last) {
+  const size_t tasks = (last - first) * 2;
+  if (scratch_.size() < tasks) scratch_.resize(tasks);
+  tbb::parallel_for(size_t{0}, tasks, [&](size_t t) {
+    const size_t i = first + t / 2;
+    const Ear ear = static_cast<Ear>(t % 2);
+    auto& scratch = scratch_[t];
+    if (scratch.size() != convolver_.fft_size()) scratch.assign(convolver_.fft_size(), 0.0f);
+    thread_local Spectrum product;
+    product.resize(convolver_.fft_size() / 2 + 1);
+    convolver_.convolve(variant(events[i].sound, events[i].pitch_semitones).spectrum,
+                        convolver_.brir_spectrum(pairs[i].first, pairs[i].second, ear), scratch,
+                        product);
+  });
+}
+
+// Adds one convolved event (its two ears' scratch buffers) at `start` and records its peak.
+void SweepRenderer::add_event(SweepAudio& out, SweepEvent& event, size_t start,
+                              const AlignedSamples* ears) const {
+  const size_t n = convolver_.output_length(variant(event.sound, event.pitch_semitones).samples.size());
+  float peak = 0.0f;
+  for (int ear = 0; ear < 2; ++ear) {
+    float* dst = (ear == 0 ? out.left.data() : out.right.data()) + start;
+    const float* src = ears[ear].data();
+    for (size_t k = 0; k < n; ++k) dst[k] += src[k], peak = std::max(peak, std::abs(src[k]));
+  }
+  event.peak_amplitude = peak;
+}
+
 SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events, size_t min_length) {
   const BrirSet& set = brirs();
   const double fs = config_.sample_rate;
@@ -324,34 +355,17 @@ SweepAudio SweepRenderer::mix(std::vector<SweepEvent> events, size_t min_length)
   }
   convolver_.prepare(pairs);
 
-  // One task per (event, ear), each in its own scratch buffer; summed in event order below, so
-  // the output does not depend on the thread count.
-  const size_t tasks = events.size() * 2;
-  if (scratch_.size() < tasks) scratch_.resize(tasks);
-  tbb::parallel_for(size_t{0}, tasks, [&](size_t t) {
-    const size_t i = t / 2;
-    const Ear ear = static_cast<Ear>(t % 2);
-    auto& scratch = scratch_[t];
-    if (scratch.size() != convolver_.fft_size()) scratch.assign(convolver_.fft_size(), 0.0f);
-    thread_local Spectrum product;
-    product.resize(convolver_.fft_size() / 2 + 1);
-    convolver_.convolve(variant(events[i].sound, events[i].pitch_semitones).spectrum,
-                        convolver_.brir_spectrum(pairs[i].first, pairs[i].second, ear), scratch,
-                        product);
-  });
   SweepAudio out;
   out.sample_rate = fs;
   out.left.assign(length, 0.0f);
   out.right.assign(length, 0.0f);
-  for (size_t i = 0; i < events.size(); ++i) {
-    const size_t n = convolver_.output_length(variant(events[i].sound, events[i].pitch_semitones).samples.size());
-    float peak = 0.0f;
-    for (int ear = 0; ear < 2; ++ear) {
-      float* dst = (ear == 0 ? out.left.data() : out.right.data()) + starts[i];
-      const float* src = scratch_[2 * i + ear].data();
-      for (size_t k = 0; k < n; ++k) dst[k] += src[k], peak = std::max(peak, std::abs(src[k]));
-    }
-    events[i].peak_amplitude = peak;
+  // One task per (event, ear), each in its own scratch buffer, a block of events at a time;
+  // summed in event order, so the output does not depend on the thread count. Blocks bound the
+  // scratch (a buffer of fft_size() samples per task: 36 events of one sweep held 19 MB at once).
+  for (size_t first = 0; first < events.size(); first += kEventsPerBlock) {
+    const size_t last = std::min(events.size(), first + kEventsPerBlock);
+    convolve_block(events, pairs, first, last);
+    for (size_t i = first; i < last; ++i) add_event(out, events[i], starts[i], &scratch_[2 * (i - first)]);
   }
   out.events = std::move(events);
   return out;

@@ -144,6 +144,11 @@ class SweepRenderer {
     Spectrum spectrum;
   };
   const Variant& variant(SoundKind kind, double semitones) const;
+  // Convolves events [first, last) into scratch_ (two buffers per event, left then right).
+  void convolve_block(const std::vector<SweepEvent>& events,
+                      const std::vector<std::pair<size_t, size_t>>& pairs, size_t first, size_t last);
+  void add_event(SweepAudio& out, SweepEvent& event, size_t start, const AlignedSamples* ears) const;
+  static constexpr size_t kEventsPerBlock = 8;
   size_t longest_sound() const;
   size_t period_samples() const;
   void level(SweepAudio& audio);
