@@ -124,6 +124,7 @@ class SweepRenderer {
 
   const SweepConfig& config() const { return config_; }
   const BrirSet& brirs() const { return convolver_.brirs(); }
+  size_t fft_size() const { return convolver_.fft_size(); }  // the convolution's transform
   std::vector<SweepEvent> schedule(const Circle& circle) const;
   // Renders and levels the sweep (config().level).
   SweepAudio render(const Circle& circle);

@@ -49,9 +49,7 @@ void bench_sonify(const BenchSonifyOptions& o, const GlobalOptions& global) {
               "FFT size %zu, %d repetitions\n",
               events, brirs->ir_length(), brirs->sample_rate(),
               o.setup.brir_dir.empty() ? "synthesised" : "loaded", load_s,
-              static_cast<size_t>(std::pow(2.0, std::ceil(std::log2(double(
-                  brirs->ir_length() + renderer.sound(audio::SoundKind::Tap, o.setup.sweep.pitch.near_semitones).size()))))),
-              o.repetitions);
+              renderer.fft_size(), o.repetitions);
   std::printf("%7s | %16s %16s | %18s %18s | %14s\n", "threads", "cached wall ms",
               "cached cpu ms", "uncached wall ms", "uncached cpu ms", "cpu ms/tap+ear");
   for (int threads : {1, 2}) {
