@@ -126,16 +126,26 @@ double band_weight(double f, size_t band) {
   return std::max(0.0, 1.0 - std::abs(x - centre));  // octave spacing: neighbours 1 apart
 }
 
-// Decaying noise of `length` samples: each octave band decays with its own RT60.
-std::vector<float> decaying_noise(size_t length, double fs, const std::vector<double>& band_rt60,
-                                  uint64_t seed, uint64_t stream) {
-  std::vector<float> noise = unit_noise(length, seed, stream);
+// The decay of each octave band over `length` samples, exp(-ln(1000) t / RT60): one envelope
+// when all bands share their RT60. The same for every source: made once per synthesizer.
+std::vector<std::vector<float>> band_envelopes(size_t length, double fs, const std::vector<double>& band_rt60) {
   const bool uniform = std::all_of(band_rt60.begin(), band_rt60.end(),
                                    [&](double t) { return t == band_rt60.front(); });
-  std::vector<float> out(length, 0.0f);
-  if (uniform) {
+  std::vector<std::vector<float>> out(uniform ? 1 : band_rt60.size(), std::vector<float>(length));
+  for (size_t b = 0; b < out.size(); ++b)
     for (size_t i = 0; i < length; ++i)
-      out[i] = noise[i] * static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60.front()));
+      out[b][i] = static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60[b]));
+  return out;
+}
+
+// Decaying noise: each octave band decays by its own envelope (band_envelopes).
+std::vector<float> decaying_noise(const std::vector<std::vector<float>>& envelopes, double fs,
+                                  uint64_t seed, uint64_t stream) {
+  const size_t length = envelopes.front().size();
+  std::vector<float> noise = unit_noise(length, seed, stream);
+  std::vector<float> out(length, 0.0f);
+  if (envelopes.size() == 1) {
+    for (size_t i = 0; i < length; ++i) out[i] = noise[i] * envelopes.front()[i];
     return out;
   }
   const RealFft fft(next_power_of_two(length) * 2);
@@ -143,28 +153,36 @@ std::vector<float> decaying_noise(size_t length, double fs, const std::vector<do
   std::copy(noise.begin(), noise.end(), time.begin());
   Spectrum spectrum(fft.bins()), band(fft.bins());
   fft.forward(time.data(), spectrum.data());
-  for (size_t b = 0; b < band_rt60.size(); ++b) {
+  for (size_t b = 0; b < envelopes.size(); ++b) {
     for (size_t k = 0; k < fft.bins(); ++k)
       band[k] = spectrum[k] * static_cast<float>(band_weight(k * fs / fft.size(), b));
     fft.inverse(band.data(), time.data());
-    for (size_t i = 0; i < length; ++i)
-      out[i] += time[i] / fft.size() *
-                static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60[b]));
+    for (size_t i = 0; i < length; ++i) out[i] += time[i] / fft.size() * envelopes[b][i];
   }
   return out;
 }
 
+// Each bin of a spectrum lies between two twelfth-octave band centres: the lower one's index
+// and the upper one's weight (the same for every frame of a tail: made once).
+struct BandPlaces {
+  size_t bands = 0;
+  std::vector<std::pair<size_t, double>> of_bin;
+  BandPlaces(double fs, size_t fft_size, size_t bins) {
+    constexpr double kLowest = 50.0, kPerOctave = 12.0;
+    bands = static_cast<size_t>(std::ceil(kPerOctave * std::log2(0.5 * fs / kLowest))) + 1;
+    for (size_t k = 0; k < bins; ++k) {
+      const double x = kPerOctave * std::log2(std::max(k * fs / fft_size, kLowest) / kLowest);
+      const size_t b = std::min(static_cast<size_t>(x), bands - 1);
+      of_bin.emplace_back(b, std::min(1.0, x - b));
+    }
+  }
+};
+
 // Gives two spectra the same energy in every twelfth of an octave (the mean of the two). The
 // per-bin gains are smooth in frequency (triangular weights in log frequency): short filters.
-void balance_spectra(Spectrum& l, Spectrum& r, double fs, size_t fft_size) {
-  constexpr double kLowest = 50.0, kPerOctave = 12.0;
-  const size_t bands = static_cast<size_t>(std::ceil(kPerOctave * std::log2(0.5 * fs / kLowest))) + 1;
-  // Each bin lies between two band centres: the lower one and the upper one's weight.
-  auto place = [&](size_t k) {
-    const double x = kPerOctave * std::log2(std::max(k * fs / fft_size, kLowest) / kLowest);
-    const size_t b = std::min(static_cast<size_t>(x), bands - 1);
-    return std::make_pair(b, std::min(1.0, x - b));
-  };
+void balance_spectra(Spectrum& l, Spectrum& r, const BandPlaces& places) {
+  const size_t bands = places.bands;
+  auto place = [&](size_t k) { return places.of_bin[k]; };
   std::vector<double> el(bands + 1, 0.0), er(bands + 1, 0.0);
   for (size_t k = 0; k < l.size(); ++k) {
     const auto [b, w] = place(k);
@@ -196,12 +214,14 @@ void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs
   AlignedSamples time(fft.size());
   Spectrum l(fft.bins()), r(fft.bins());
   std::vector<float> out_l(n + 3 * frame, 0.0f), out_r(n + 3 * frame, 0.0f);
+  const BandPlaces places(fs, fft.size(), fft.bins());
+  std::vector<double> hann(frame);  // periodic
+  for (size_t i = 0; i < frame; ++i) hann[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);
   auto analyse = [&](const std::vector<float>& x, long start, Spectrum& spectrum) {
     std::fill(time.begin(), time.end(), 0.0f);
     for (size_t i = 0; i < frame; ++i) {
       const long j = start + static_cast<long>(i);
-      const double w = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);  // periodic Hann
-      if (j >= 0 && j < static_cast<long>(n)) time[pad + i] = static_cast<float>(w * x[j]);
+      if (j >= 0 && j < static_cast<long>(n)) time[pad + i] = static_cast<float>(hann[i] * x[j]);
     }
     fft.forward(time.data(), spectrum.data());
   };
@@ -216,7 +236,7 @@ void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs
   for (long start = -static_cast<long>(hop); start < static_cast<long>(n); start += hop) {
     analyse(left, start, l);
     analyse(right, start, r);
-    balance_spectra(l, r, fs, fft.size());
+    balance_spectra(l, r, places);
     add_back(l, out_l, start);
     add_back(r, out_r, start);
   }
@@ -282,7 +302,7 @@ BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
     const double c = config_.speed_of_sound;
     tail_level_ = std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate));
   }
-  band_rt60_ = std::move(band_rt60);
+  band_envelopes_ = band_envelopes(length_, config_.sample_rate, band_rt60);
 }
 
 size_t BrirSynthesizer::direct_end(double distance_m) const {
@@ -293,14 +313,15 @@ size_t BrirSynthesizer::direct_end(double distance_m) const {
 // The late tail of one source from `start` on (faded in), its own noise per ear, ears balanced.
 BinauralIr BrirSynthesizer::late_tail(double azimuth_deg, double distance_m, size_t start) const {
   const uint64_t stream = direction_stream(azimuth_deg, distance_m);
-  BinauralIr tail{decaying_noise(length_, config_.sample_rate, band_rt60_, config_.seed, stream),
-                  decaying_noise(length_, config_.sample_rate, band_rt60_, config_.seed, stream + 1)};
+  BinauralIr tail{decaying_noise(band_envelopes_, config_.sample_rate, config_.seed, stream),
+                  decaying_noise(band_envelopes_, config_.sample_rate, config_.seed, stream + 1)};
   const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * config_.sample_rate));
+  // A raised-cosine fade-in over `fade` samples from `start`: silent before, full after.
+  auto gain = [&](double t) { return static_cast<float>(tail_level_ * (0.5 - 0.5 * std::cos(kPi * t))); };
+  const float silent = gain(0.0), full = gain(1.0);
   auto window = [&](std::vector<float>& x) {
-    for (size_t i = 0; i < length_; ++i) {
-      const double t = i < start ? 0.0 : std::min(1.0, double(i - start) / fade);
-      x[i] *= static_cast<float>(tail_level_ * (0.5 - 0.5 * std::cos(kPi * t)));
-    }
+    for (size_t i = 0; i < length_; ++i)
+      x[i] *= i < start ? silent : i - start >= fade ? full : gain(double(i - start) / fade);
   };
   window(tail.left);
   window(tail.right);

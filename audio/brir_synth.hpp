@@ -118,7 +118,7 @@ class BrirSynthesizer {
   size_t length_ = 0;
   double absorption_ = 0.0;
   double tail_level_ = 0.0;        // diffuse-field amplitude at t = 0
-  std::vector<double> band_rt60_;  // per octave band
+  std::vector<std::vector<float>> band_envelopes_;  // per octave band, over the IR (late_tail)
 };
 
 }  // namespace sonomap::audio
