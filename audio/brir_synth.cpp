@@ -201,22 +201,33 @@ void balance_spectra(Spectrum& l, Spectrum& r, const BandPlaces& places) {
   }
 }
 
+// The ear balancing's frames (below), their window and their bins' band places: they depend
+// on the sample rate only, so each synthesizer makes them once.
+struct EarBalance {
+  size_t frame, hop, pad;  // the frame sits mid-buffer, `pad` from its start
+  RealFft fft;
+  std::vector<double> hann;  // periodic
+  BandPlaces places;
+  explicit EarBalance(double fs)
+      : frame(next_power_of_two(static_cast<size_t>(0.04 * fs))), hop(frame / 2), pad(frame / 2),
+        fft(2 * frame), hann(frame), places(fs, fft.size(), fft.bins()) {
+    for (size_t i = 0; i < frame; ++i) hann[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);
+  }
+};
+
 // Gives the two ears' tails the same energy in every twelfth of an octave and every ~43 ms
 // frame, as a diffuse field has at the ears of a symmetric head: two independent noises differ
 // by several dB in a narrow band, which would make a source straight ahead lean to one side.
 // Hann frames at 50% overlap (they sum to one), each balanced and added back whole (zero
 // padded: the short balancing filters do not wrap around).
-void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs) {
+void balance_ears(std::vector<float>& left, std::vector<float>& right, const EarBalance& shape) {
   const size_t n = left.size();
-  const size_t frame = next_power_of_two(static_cast<size_t>(0.04 * fs)), hop = frame / 2;
-  const size_t pad = frame / 2;  // the frame sits mid-buffer
-  const RealFft fft(2 * frame);
+  const size_t frame = shape.frame, hop = shape.hop, pad = shape.pad;
+  const RealFft& fft = shape.fft;
+  const std::vector<double>& hann = shape.hann;
   AlignedSamples time(fft.size());
   Spectrum l(fft.bins()), r(fft.bins());
   std::vector<float> out_l(n + 3 * frame, 0.0f), out_r(n + 3 * frame, 0.0f);
-  const BandPlaces places(fs, fft.size(), fft.bins());
-  std::vector<double> hann(frame);  // periodic
-  for (size_t i = 0; i < frame; ++i) hann[i] = 0.5 - 0.5 * std::cos(2.0 * kPi * i / frame);
   auto analyse = [&](const std::vector<float>& x, long start, Spectrum& spectrum) {
     std::fill(time.begin(), time.end(), 0.0f);
     for (size_t i = 0; i < frame; ++i) {
@@ -236,7 +247,7 @@ void balance_ears(std::vector<float>& left, std::vector<float>& right, double fs
   for (long start = -static_cast<long>(hop); start < static_cast<long>(n); start += hop) {
     analyse(left, start, l);
     analyse(right, start, r);
-    balance_spectra(l, r, places);
+    balance_spectra(l, r, shape.places);
     add_back(l, out_l, start);
     add_back(r, out_r, start);
   }
@@ -271,6 +282,13 @@ std::vector<AxisImage> axis_images(double source, double lo, double hi, int max_
 
 }  // namespace
 
+// What every late tail of one synthesizer shares: the octave bands' decay envelopes and the
+// ear balancing's frames (shared by copies of the synthesizer, not recomputed per source).
+struct BrirSynthesizer::TailShape {
+  std::vector<std::vector<float>> envelopes;
+  EarBalance balance;
+};
+
 BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
     : hrirs_(std::move(hrirs)), config_(std::move(config)) {
   validate(config_);
@@ -302,7 +320,8 @@ BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
     const double c = config_.speed_of_sound;
     tail_level_ = std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate));
   }
-  band_envelopes_ = band_envelopes(length_, config_.sample_rate, band_rt60);
+  tail_shape_ = std::make_shared<const TailShape>(
+      TailShape{band_envelopes(length_, config_.sample_rate, band_rt60), EarBalance(config_.sample_rate)});
 }
 
 size_t BrirSynthesizer::direct_end(double distance_m) const {
@@ -313,8 +332,8 @@ size_t BrirSynthesizer::direct_end(double distance_m) const {
 // The late tail of one source from `start` on (faded in), its own noise per ear, ears balanced.
 BinauralIr BrirSynthesizer::late_tail(double azimuth_deg, double distance_m, size_t start) const {
   const uint64_t stream = direction_stream(azimuth_deg, distance_m);
-  BinauralIr tail{decaying_noise(band_envelopes_, config_.sample_rate, config_.seed, stream),
-                  decaying_noise(band_envelopes_, config_.sample_rate, config_.seed, stream + 1)};
+  BinauralIr tail{decaying_noise(tail_shape_->envelopes, config_.sample_rate, config_.seed, stream),
+                  decaying_noise(tail_shape_->envelopes, config_.sample_rate, config_.seed, stream + 1)};
   const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * config_.sample_rate));
   // A raised-cosine fade-in over `fade` samples from `start`: silent before, full after.
   auto gain = [&](double t) { return static_cast<float>(tail_level_ * (0.5 - 0.5 * std::cos(kPi * t))); };
@@ -325,7 +344,7 @@ BinauralIr BrirSynthesizer::late_tail(double azimuth_deg, double distance_m, siz
   };
   window(tail.left);
   window(tail.right);
-  balance_ears(tail.left, tail.right, config_.sample_rate);
+  balance_ears(tail.left, tail.right, tail_shape_->balance);
   for (size_t i = 0; i < std::min(start, length_); ++i) tail.left[i] = tail.right[i] = 0.0f;
   return tail;
 }

@@ -118,7 +118,8 @@ class BrirSynthesizer {
   size_t length_ = 0;
   double absorption_ = 0.0;
   double tail_level_ = 0.0;        // diffuse-field amplitude at t = 0
-  std::vector<std::vector<float>> band_envelopes_;  // per octave band, over the IR (late_tail)
+  struct TailShape;  // what every late tail shares (brir_synth.cpp)
+  std::shared_ptr<const TailShape> tail_shape_;
 };
 
 }  // namespace sonomap::audio
