@@ -39,6 +39,9 @@ constexpr double kEdgePixels = 3.0;
 // A voxel the map holds as behind a surface that this frame sees only as free, by more than
 // this many voxels on average, has been vacated: an object left.
 constexpr double kVacatedVoxels = 1.0;
+// A voxel the map holds as free that this frame puts inside an object, more than this many
+// voxels behind the surface its pixel measured, has been entered: an object arrived.
+constexpr double kArrivedVoxels = 1.0;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("VdbGpdfConfig: " + what);
@@ -59,6 +62,7 @@ struct QueryUpdate {
   float distance;
   float weight;
   bool hit = false;  // from a surface point or behind it (not from free space in front)
+  bool seen_inside = false;  // inside by its votes, and its pixel saw a surface well in front
 };
 
 // The frame's depth image seen from the world: whether a point lies in front of (or behind)
@@ -688,6 +692,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   out = {voxel, static_cast<float>(sum / weight),
          static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
          votes[kHitInside] + surface_votes > 0};
+  out.seen_inside = out.hit && out.distance > 0.0f && view.seen_behind(c, kArrivedVoxels * config.global_voxel);
   return true;
 }
 
@@ -739,7 +744,15 @@ void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& u
     // being outweighed by up to weight_cap frames of it (a box's foot on the floor, whose
     // voxels only the floor's front queries reach, took 20 frames to clear).
     const bool vacated = old[0] > 0.0f && !u.hit && sum[0] < vacated_below * sum[1];
-    acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated ? 0.0f : old[1]), sum));
+    // And the other way round: space the map knew as free that this frame puts inside an
+    // object, more than a voxel behind the surface its pixel measured: something arrived,
+    // and it is in the map at once. Else a box stepping into the space a wall's front votes
+    // had held free for 30 frames reached the circle 10 to 20 frames later, which read the
+    // wall behind until then. (Seen from its other side, a wall thinner than the behind
+    // votes' reach is entered the same way: the later view's surface wins, as averaging
+    // would make it win within frames anyway.)
+    const bool arrived = old[0] < 0.0f && u.seen_inside;
+    acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated || arrived ? 0.0f : old[1]), sum));
   }
 }
 
