@@ -42,6 +42,15 @@ constexpr double kVacatedVoxels = 1.0;
 // A voxel the map holds as free that this frame puts inside an object, more than this many
 // voxels behind the surface its pixel measured, has been entered: an object arrived.
 constexpr double kArrivedVoxels = 1.0;
+// The most an inside ("behind") vote adds to a voxel's value, in voxels. Behind votes land up
+// to two query steps behind the surface, and the GPs' distance there (to the visible face)
+// says nothing of how thin the object is: a panel may end a centimetre behind its face. Next
+// to a free voxel beside a silhouette or beyond a thin object's hidden side, a large inside
+// value pulled the marching cubes' crossing past the object: with the free votes beside
+// silhouettes (vote_beside_surfaces) and no cap, the random box rooms of docs/fidelity.md had
+// 16 readings too near (11 with the cap), and on the smoke scene a box's corner ran 8 mm into
+// the next bin.
+constexpr double kInsideCapVoxels = 0.5;
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("VdbGpdfConfig: " + what);
@@ -93,6 +102,10 @@ class DepthView {
       }
     return true;
   }
+
+  // The image shows `world` free: seen_in_front, and there is an image (false without one).
+  bool shows_free(const Eigen::Vector3d& world) const { return usable_ && seen_in_front(world); }
+  bool has_image() const { return usable_; }
 
   // Projects less than `pixels` inside the image's edge (or outside the image).
   bool at_edge(const Eigen::Vector3d& world, double pixels) const {
@@ -651,6 +664,23 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
     }
 }
 
+// Every voxel near the frame's points that no vote reached gets one free vote, which
+// voxel_update keeps only where the depth image shows its centre free. Beside a silhouette no
+// surface point has free space in front of it and carving rays cross only voxels observed
+// before, so that space was never given a value, and marching cubes, which needs all eight
+// corners of a cube, ended the surface up to half a voxel short of the silhouette
+// (scenes/smoke.yaml: the ball's limb 2.5 cm short, and bins it enters read the wall behind).
+// The space then counts as observed and gathers carving votes; a person stepping into it is
+// in the map at once by the arrival rule (fuse_updates).
+void vote_beside_surfaces(const DepthView& view, const openvdb::MaskGrid& near, VoteGrid& counts) {
+  if (!view.has_image()) return;
+  auto acc = counts.getAccessor();
+  VoteCounts free_vote(0);
+  free_vote[kFree] = 1;
+  for (auto v = near.cbeginValueOn(); v; ++v)
+    if (!acc.isValueOn(v.getCoord())) acc.setValue(v.getCoord(), free_vote);
+}
+
 // One voxel's update from its votes and the local GPs' distance d at its centre: each kept
 // vote adds +-d with one unit of weight. Near the surface a free-space value needs the depth
 // image's word for it (DepthView): a centre the camera saw behind the surface keeps no
@@ -663,6 +693,10 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
   if (surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) surface[2] = surface[3] = 0.0f;
   if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
+  // A point behind the surface whose centre the camera saw through is not inside: beside a
+  // silhouette the normal leans sideways and its behind points land in free space (with the
+  // free votes of vote_beside_surfaces they made the surface bulge past the silhouette).
+  if (votes[kHitInside] > 0 && view.shows_free(c)) votes[kHitInside] = 0;
   // A front point's centre behind the tangent plane: free if the camera saw through it, inside
   // if its pixel saw the surface nearer, else unknown (beside a silhouette, where a curved or
   // grazing surface's plane is no guide: a column's edge grew 8 cm into free space).
@@ -688,7 +722,10 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
     distance = pred.distance;
     variance = pred.variance;
   }
-  const double sum = surface[0] + surface[2] + distance * (inside - free);
+  // An inside vote's value is capped: it says the centre is inside, not how deep (see
+  // kInsideCapVoxels).
+  const double inside_distance = std::min(distance, kInsideCapVoxels * config.global_voxel);
+  const double sum = surface[0] + surface[2] + inside_distance * inside - distance * free;
   out = {voxel, static_cast<float>(sum / weight),
          static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
          votes[kHitInside] + surface_votes > 0};
@@ -711,6 +748,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   VoteGrid counts(VoteCounts(0));
   SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
   count_votes(votes, counts, surface);
+  vote_beside_surfaces(view, local.near, counts);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
   counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
