@@ -787,8 +787,7 @@ void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& u
     // and it is in the map at once. Else a box stepping into the space a wall's front votes
     // had held free for 30 frames reached the circle 10 to 20 frames later, which read the
     // wall behind until then. (Seen from its other side, a wall thinner than the behind
-    // votes' reach is entered the same way: the later view's surface wins, as averaging
-    // would make it win within frames anyway.)
+    // votes' reach is entered the same way, and the later view's surface wins.)
     const bool arrived = old[0] < 0.0f && u.seen_inside;
     acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated || arrived ? 0.0f : old[1]), sum));
   }

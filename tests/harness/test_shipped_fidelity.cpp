@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The shipped smoke scene, whole and at full resolution: VDB-GPDF's circle against its peers'
 // on the same frames, each against the exact truth the run writes beside it (circle.csv).
-#include "run_support.hpp"
 #include "test_scenario_files.hpp"
 
 #include "harness/app/run.hpp"
