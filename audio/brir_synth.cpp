@@ -126,38 +126,48 @@ double band_weight(double f, size_t band) {
   return std::max(0.0, 1.0 - std::abs(x - centre));  // octave spacing: neighbours 1 apart
 }
 
-// The decay of each octave band over `length` samples, exp(-ln(1000) t / RT60): one envelope
-// when all bands share their RT60. The same for every source: made once per synthesizer.
-std::vector<std::vector<float>> band_envelopes(size_t length, double fs, const std::vector<double>& band_rt60) {
-  const bool uniform = std::all_of(band_rt60.begin(), band_rt60.end(),
-                                   [&](double t) { return t == band_rt60.front(); });
-  std::vector<std::vector<float>> out(uniform ? 1 : band_rt60.size(), std::vector<float>(length));
-  for (size_t b = 0; b < out.size(); ++b)
-    for (size_t i = 0; i < length; ++i)
-      out[b][i] = static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60[b]));
-  return out;
-}
+// The octave bands of a late tail over `length` samples: each band's decay, exp(-ln(1000) t /
+// RT60) (one envelope when all bands share their RT60), and, when they differ, each band's
+// weight per bin of the transform that splits the noise into bands. The same for every
+// source: made once per synthesizer.
+struct TailBands {
+  std::vector<std::vector<float>> envelopes;
+  size_t split_size = 0;                    // the splitting transform's size (0: no split)
+  std::vector<std::vector<float>> weights;  // per band, per bin of that transform
+  TailBands(size_t length, double fs, const std::vector<double>& band_rt60) {
+    const bool uniform = std::all_of(band_rt60.begin(), band_rt60.end(),
+                                     [&](double t) { return t == band_rt60.front(); });
+    envelopes.assign(uniform ? 1 : band_rt60.size(), std::vector<float>(length));
+    for (size_t b = 0; b < envelopes.size(); ++b)
+      for (size_t i = 0; i < length; ++i)
+        envelopes[b][i] = static_cast<float>(std::exp(-kLn1e3 * (i / fs) / band_rt60[b]));
+    if (uniform) return;
+    split_size = next_power_of_two(length) * 2;
+    weights.assign(envelopes.size(), std::vector<float>(split_size / 2 + 1));
+    for (size_t b = 0; b < weights.size(); ++b)
+      for (size_t k = 0; k < weights[b].size(); ++k)
+        weights[b][k] = static_cast<float>(band_weight(k * fs / split_size, b));
+  }
+};
 
-// Decaying noise: each octave band decays by its own envelope (band_envelopes).
-std::vector<float> decaying_noise(const std::vector<std::vector<float>>& envelopes, double fs,
-                                  uint64_t seed, uint64_t stream) {
-  const size_t length = envelopes.front().size();
+// Decaying noise: each octave band decays by its own envelope (TailBands).
+std::vector<float> decaying_noise(const TailBands& bands, uint64_t seed, uint64_t stream) {
+  const size_t length = bands.envelopes.front().size();
   std::vector<float> noise = unit_noise(length, seed, stream);
   std::vector<float> out(length, 0.0f);
-  if (envelopes.size() == 1) {
-    for (size_t i = 0; i < length; ++i) out[i] = noise[i] * envelopes.front()[i];
+  if (bands.envelopes.size() == 1) {
+    for (size_t i = 0; i < length; ++i) out[i] = noise[i] * bands.envelopes.front()[i];
     return out;
   }
-  const RealFft fft(next_power_of_two(length) * 2);
+  const RealFft fft(bands.split_size);
   AlignedSamples time(fft.size(), 0.0f);
   std::copy(noise.begin(), noise.end(), time.begin());
   Spectrum spectrum(fft.bins()), band(fft.bins());
   fft.forward(time.data(), spectrum.data());
-  for (size_t b = 0; b < envelopes.size(); ++b) {
-    for (size_t k = 0; k < fft.bins(); ++k)
-      band[k] = spectrum[k] * static_cast<float>(band_weight(k * fs / fft.size(), b));
+  for (size_t b = 0; b < bands.envelopes.size(); ++b) {
+    for (size_t k = 0; k < fft.bins(); ++k) band[k] = spectrum[k] * bands.weights[b][k];
     fft.inverse(band.data(), time.data());
-    for (size_t i = 0; i < length; ++i) out[i] += time[i] / fft.size() * envelopes[b][i];
+    for (size_t i = 0; i < length; ++i) out[i] += time[i] / fft.size() * bands.envelopes[b][i];
   }
   return out;
 }
@@ -182,10 +192,9 @@ struct BandPlaces {
 // per-bin gains are smooth in frequency (triangular weights in log frequency): short filters.
 void balance_spectra(Spectrum& l, Spectrum& r, const BandPlaces& places) {
   const size_t bands = places.bands;
-  auto place = [&](size_t k) { return places.of_bin[k]; };
   std::vector<double> el(bands + 1, 0.0), er(bands + 1, 0.0);
   for (size_t k = 0; k < l.size(); ++k) {
-    const auto [b, w] = place(k);
+    const auto [b, w] = places.of_bin[k];
     el[b] += (1.0 - w) * std::norm(l[k]), el[b + 1] += w * std::norm(l[k]);
     er[b] += (1.0 - w) * std::norm(r[k]), er[b + 1] += w * std::norm(r[k]);
   }
@@ -195,7 +204,7 @@ void balance_spectra(Spectrum& l, Spectrum& r, const BandPlaces& places) {
     if (el[b] > 0.0 && er[b] > 0.0) gl[b] = std::sqrt(mean / el[b]), gr[b] = std::sqrt(mean / er[b]);
   }
   for (size_t k = 0; k < l.size(); ++k) {
-    const auto [b, w] = place(k);
+    const auto [b, w] = places.of_bin[k];
     l[k] *= static_cast<float>((1.0 - w) * gl[b] + w * gl[b + 1]);
     r[k] *= static_cast<float>((1.0 - w) * gr[b] + w * gr[b + 1]);
   }
@@ -282,10 +291,10 @@ std::vector<AxisImage> axis_images(double source, double lo, double hi, int max_
 
 }  // namespace
 
-// What every late tail of one synthesizer shares: the octave bands' decay envelopes and the
-// ear balancing's frames (shared by copies of the synthesizer, not recomputed per source).
+// What every late tail of one synthesizer shares: its octave bands and the ear balancing's
+// frames (shared by copies of the synthesizer, not recomputed per source).
 struct BrirSynthesizer::TailShape {
-  std::vector<std::vector<float>> envelopes;
+  TailBands bands;
   EarBalance balance;
 };
 
@@ -321,7 +330,7 @@ BrirSynthesizer::BrirSynthesizer(HrirSet hrirs, BrirSynthConfig config)
     tail_level_ = std::sqrt(4.0 * kPi * c * hrir_energy / (config_.room.volume() * config_.sample_rate));
   }
   tail_shape_ = std::make_shared<const TailShape>(
-      TailShape{band_envelopes(length_, config_.sample_rate, band_rt60), EarBalance(config_.sample_rate)});
+      TailShape{TailBands(length_, config_.sample_rate, band_rt60), EarBalance(config_.sample_rate)});
 }
 
 size_t BrirSynthesizer::direct_end(double distance_m) const {
@@ -332,8 +341,8 @@ size_t BrirSynthesizer::direct_end(double distance_m) const {
 // The late tail of one source from `start` on (faded in), its own noise per ear, ears balanced.
 BinauralIr BrirSynthesizer::late_tail(double azimuth_deg, double distance_m, size_t start) const {
   const uint64_t stream = direction_stream(azimuth_deg, distance_m);
-  BinauralIr tail{decaying_noise(tail_shape_->envelopes, config_.sample_rate, config_.seed, stream),
-                  decaying_noise(tail_shape_->envelopes, config_.sample_rate, config_.seed, stream + 1)};
+  BinauralIr tail{decaying_noise(tail_shape_->bands, config_.seed, stream),
+                  decaying_noise(tail_shape_->bands, config_.seed, stream + 1)};
   const size_t fade = std::max<size_t>(1, static_cast<size_t>(kTailFadeS * config_.sample_rate));
   // A raised-cosine fade-in over `fade` samples from `start`: silent before, full after.
   auto gain = [&](double t) { return static_cast<float>(tail_level_ * (0.5 - 0.5 * std::cos(kPi * t))); };

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "core/grid_walk.hpp"
@@ -103,8 +104,6 @@ class DepthView {
     return true;
   }
 
-  // The image shows `world` free: seen_in_front, and there is an image (false without one).
-  bool shows_free(const Eigen::Vector3d& world) const { return usable_ && seen_in_front(world); }
   bool has_image() const { return usable_; }
 
   // Projects less than `pixels` inside the image's edge (or outside the image).
@@ -691,17 +690,22 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
                   openvdb::Vec4f surface, const LocalGps& locals,
                   const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
   const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
+  std::optional<bool> in_front;  // view.seen_in_front(c) (9 pixels), asked at most once
+  auto seen_in_front = [&] {
+    if (!in_front) in_front = view.seen_in_front(c);
+    return *in_front;
+  };
   if (surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) surface[2] = surface[3] = 0.0f;
-  if (votes[kFree] > 0 && near.isValueOn(voxel) && !view.seen_in_front(c)) votes[kFree] = 0;
+  if (votes[kFree] > 0 && near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
   // free votes of vote_beside_surfaces they made the surface bulge past the silhouette).
-  if (votes[kHitInside] > 0 && view.shows_free(c)) votes[kHitInside] = 0;
+  if (votes[kHitInside] > 0 && view.has_image() && seen_in_front()) votes[kHitInside] = 0;
   // A front point's centre behind the tangent plane: free if the camera saw through it, inside
   // if its pixel saw the surface nearer, else unknown (beside a silhouette, where a curved or
   // grazing surface's plane is no guide: a column's edge grew 8 cm into free space).
   if (votes[kFrontInside] > 0) {
-    if (view.seen_in_front(c)) {
+    if (seen_in_front()) {
       votes[kFree] += votes[kFrontInside];
       votes[kFrontInside] = 0;
     } else if (!view.seen_behind(c, kBehindMargin * config.global_voxel)) {
