@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "core/gp.hpp"
+#include "core/vector_isa.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -27,49 +28,129 @@ double kernel_rate(const GpParams& p) {
   return p.kernel == GpKernel::RevertingSE ? p.lambda : std::sqrt(3.0 * p.lambda);
 }
 
-// Prediction runs over the training points four at a time in GCC/Clang vector types: plain
-// IEEE float operations, lane by lane, so the result has the same bits whatever SIMD width the
-// compiler picks (the baseline target's SSE2 register holds all four) and with any C library. Sums are kept per lane
-// and added up in a fixed order at the end.
+// Prediction runs over the training points in GCC/Clang vector types: plain IEEE float
+// operations, lane by lane, so every term has the same bits whatever the vector width, and
+// with any C library. The widest copy the CPU runs (core/vector_isa.hpp: 4 lanes on the
+// baseline, 8 with AVX2, 16 with AVX-512) computes the terms; they are summed into four lanes,
+// four terms at a time in the points' order, and the four added up in a fixed order at the
+// end: the sums are those of the 4-lane baseline, to the bit.
+// The wide helpers below take and return 32- and 64-byte vectors; they are always inlined into
+// kernels built for the instruction set that holds them, so no call passes such a vector and
+// GCC's note that their calling convention differs without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
 constexpr size_t kLanes = 4;
-using Floats = float __attribute__((vector_size(kLanes * sizeof(float))));
-using Ints = int32_t __attribute__((vector_size(kLanes * sizeof(int32_t))));
+constexpr size_t kWidest = 16;  // the training points are padded to a multiple of this
+template <size_t L>
+struct Lanes {  // (an alias template drops a dependent vector_size)
+  typedef float Floats __attribute__((vector_size(L * sizeof(float))));
+  typedef int32_t Ints __attribute__((vector_size(L * sizeof(int32_t))));
+};
+template <size_t L>
+using WideFloats = typename Lanes<L>::Floats;
+template <size_t L>
+using WideInts = typename Lanes<L>::Ints;
+using Floats = WideFloats<kLanes>;
 
-Floats load(const float* p) {
-  Floats v;
+template <size_t L>
+SONOMAP_VECTOR_LOOP WideFloats<L> load(const float* p) {
+  WideFloats<L> v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
 
 // e^x for x <= 0 (Cephes' expf polynomial, relative error about 2e-7). Below -87 it gives
 // e^-87 (1.6e-38): kernel terms that small vanish next to the largest, which is 1.
-Floats exp_nonpositive(Floats x) {
-  const Floats floor_x = Floats{} - 87.0f;
+template <size_t L>
+SONOMAP_VECTOR_LOOP WideFloats<L> exp_nonpositive(WideFloats<L> x) {
+  using W = WideFloats<L>;
+  const W floor_x = W{} - 87.0f;
   x = x < floor_x ? floor_x : x;
-  const Floats round = Floats{} + 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
-  const Floats n = (x * 1.44269504088896341f + round) - round;
-  const Floats r = (x - n * 0.693359375f) - n * -2.12194440e-4f;  // ln 2 in two parts
-  Floats p = Floats{} + 1.9875691500e-4f;
+  const W round = W{} + 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
+  const W n = (x * 1.44269504088896341f + round) - round;
+  const W r = (x - n * 0.693359375f) - n * -2.12194440e-4f;  // ln 2 in two parts
+  W p = W{} + 1.9875691500e-4f;
   p = p * r + 1.3981999507e-3f;
   p = p * r + 8.3334519073e-3f;
   p = p * r + 4.1665795894e-2f;
   p = p * r + 1.6666665459e-1f;
   p = p * r + 5.0000001201e-1f;
   p = p * r * r + r + 1.0f;
-  const Ints bits = (__builtin_convertvector(n, Ints) + 127) << 23;  // 2^n
-  return p * (Floats)bits;  // a vector cast keeps the bits
+  const WideInts<L> bits = (__builtin_convertvector(n, WideInts<L>) + 127) << 23;  // 2^n
+  return p * (W)bits;  // a vector cast keeps the bits
 }
 
-float lane_max(Floats v) {
-  float m = v[0];
-  for (size_t j = 1; j < kLanes; ++j) m = v[j] > m ? v[j] : m;
-  return m;
+// Adds v's lanes to the four of `sum`, four at a time in order.
+template <size_t L>
+SONOMAP_VECTOR_LOOP void add_by_fours(Floats& sum, WideFloats<L> v) {
+  float lanes[L];
+  std::memcpy(lanes, &v, sizeof v);
+  for (size_t q = 0; q < L; q += kLanes) sum += load<kLanes>(&lanes[q]);
 }
 
 double lane_sum(Floats v) {
   double s = 0.0;
   for (size_t j = 0; j < kLanes; ++j) s += v[j];
   return s;
+}
+
+// One prediction's input: the training points relative to the anchor, one array per axis,
+// their weights (padded to kWidest with points 1 km away and weight 0), and the query.
+struct KernelInput {
+  const float *xs, *ys, *zs, *alpha;
+  size_t padded;
+  float qx, qy, qz, rate;
+  bool se;
+};
+
+// Its sums: the largest exponent, and f and grad f / (-rate) in four lanes.
+struct KernelSums {
+  float max_expo;
+  Floats f, gx, gy, gz;
+};
+
+// Fills expo (the kernel terms' exponents) and radius (the squared radius for the SE kernel,
+// which needs no square root) and sums every term scaled by exp(-max exponent).
+template <size_t L, bool kGradient>
+SONOMAP_VECTOR_LOOP void sum_kernel_terms(const KernelInput& in, float* expo, float* radius, KernelSums& out) {
+  using W = WideFloats<L>;
+  W top = W{} - std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i < in.padded; i += L) {
+    const W dx = in.qx - load<L>(in.xs + i), dy = in.qy - load<L>(in.ys + i), dz = in.qz - load<L>(in.zs + i);
+    W r = dx * dx + dy * dy + dz * dz;
+    if (!in.se)
+      for (size_t j = 0; j < L; ++j) r[j] = std::sqrt(r[j]);
+    const W e = in.se ? -0.5f * in.rate * r : -in.rate * r;
+    std::memcpy(radius + i, &r, sizeof r);
+    std::memcpy(expo + i, &e, sizeof e);
+    top = e > top ? e : top;
+  }
+  float max_expo = top[0];
+  for (size_t j = 1; j < L; ++j) max_expo = top[j] > max_expo ? top[j] : max_expo;
+  out.max_expo = max_expo;
+  out.f = out.gx = out.gy = out.gz = Floats{};
+  for (size_t i = 0; i < in.padded; i += L) {
+    const W w = load<L>(in.alpha + i) * exp_nonpositive<L>(load<L>(expo + i) - max_expo);
+    if constexpr (kGradient) {
+      add_by_fours<L>(out.gx, w * (in.qx - load<L>(in.xs + i)));
+      add_by_fours<L>(out.gy, w * (in.qy - load<L>(in.ys + i)));
+      add_by_fours<L>(out.gz, w * (in.qz - load<L>(in.zs + i)));
+    }
+    add_by_fours<L>(out.f, in.se ? w : w * (1.0f + in.rate * load<L>(radius + i)));
+  }
+}
+
+template <bool kGradient>
+void sum_kernel_terms_baseline(const KernelInput& in, float* expo, float* radius, KernelSums& out) {
+  sum_kernel_terms<kLanes, kGradient>(in, expo, radius, out);
+}
+template <bool kGradient>
+SONOMAP_AVX2_KERNEL void sum_kernel_terms_avx2(const KernelInput& in, float* expo, float* radius, KernelSums& out) {
+  sum_kernel_terms<8, kGradient>(in, expo, radius, out);
+}
+template <bool kGradient>
+SONOMAP_AVX512_KERNEL void sum_kernel_terms_avx512(const KernelInput& in, float* expo, float* radius,
+                                                   KernelSums& out) {
+  sum_kernel_terms<16, kGradient>(in, expo, radius, out);
 }
 }  // namespace
 
@@ -82,7 +163,7 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
   const int n = static_cast<int>(points_.size());
   anchor_ = points_[0].cast<double>();
   // Padded to whole vectors with points 1 km away and no weight: their terms are zero.
-  const size_t padded = (points_.size() + kLanes - 1) / kLanes * kLanes;
+  const size_t padded = (points_.size() + kWidest - 1) / kWidest * kWidest;
   xs_.assign(padded, 1000.0f);
   ys_.assign(padded, 0.0f);
   zs_.assign(padded, 0.0f);
@@ -122,37 +203,28 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   const bool se = params_.kernel == GpKernel::RevertingSE;
   const Eigen::Vector3d rel = x - anchor_;
   if (!rel.allFinite()) return out;
-  const float qx = static_cast<float>(rel.x()), qy = static_cast<float>(rel.y()), qz = static_cast<float>(rel.z());
-  const float rate = static_cast<float>(a_);
-  const size_t padded = xs_.size();
-  // Exponents of the kernel terms; every term is scaled by exp(-max exponent).
-  // radius holds the squared radius for the SE kernel (it needs no square root).
-  thread_local std::vector<float> expo, radius;
-  expo.resize(padded);
-  radius.resize(padded);
-  Floats top = Floats{} - std::numeric_limits<float>::infinity();
-  for (size_t i = 0; i < padded; i += kLanes) {
-    const Floats dx = qx - load(&xs_[i]), dy = qy - load(&ys_[i]), dz = qz - load(&zs_[i]);
-    Floats r = dx * dx + dy * dy + dz * dz;
-    if (!se)
-      for (size_t j = 0; j < kLanes; ++j) r[j] = std::sqrt(r[j]);
-    const Floats e = se ? -0.5f * rate * r : -rate * r;
-    std::memcpy(&radius[i], &r, sizeof r);
-    std::memcpy(&expo[i], &e, sizeof e);
-    top = e > top ? e : top;
+  const KernelInput in{xs_.data(), ys_.data(), zs_.data(), alpha_lanes_.data(), xs_.size(),
+                       static_cast<float>(rel.x()), static_cast<float>(rel.y()), static_cast<float>(rel.z()),
+                       static_cast<float>(a_), se};
+  // Scratch on the stack for the usual sizes (a local GP has at most about 100 points).
+  constexpr size_t kOnStack = 256;
+  float expo_stack[kOnStack], radius_stack[kOnStack];
+  thread_local std::vector<float> expo_heap, radius_heap;
+  float* expo = expo_stack;
+  float* radius = radius_stack;
+  if (in.padded > kOnStack) {
+    expo_heap.resize(in.padded);
+    radius_heap.resize(in.padded);
+    expo = expo_heap.data();
+    radius = radius_heap.data();
   }
-  const float max_expo = lane_max(top);
-  Floats f = {};
-  [[maybe_unused]] Floats gx = {}, gy = {}, gz = {};  // f and grad f / (-rate), per lane
-  for (size_t i = 0; i < padded; i += kLanes) {
-    Floats w = load(&alpha_lanes_[i]) * exp_nonpositive(load(&expo[i]) - max_expo);
-    if constexpr (kGradient) {
-      gx += w * (qx - load(&xs_[i]));
-      gy += w * (qy - load(&ys_[i]));
-      gz += w * (qz - load(&zs_[i]));
-    }
-    f += se ? w : w * (1.0f + rate * load(&radius[i]));
-  }
+  const auto sum_terms = kernel_for(vector_isa(), &sum_kernel_terms_baseline<kGradient>,
+                                    &sum_kernel_terms_avx2<kGradient>, &sum_kernel_terms_avx512<kGradient>);
+  KernelSums sums;
+  sum_terms(in, expo, radius, sums);
+  const float max_expo = sums.max_expo;
+  const Floats f = sums.f;
+  [[maybe_unused]] const Floats gx = sums.gx, gy = sums.gy, gz = sums.gz;
   const double s = lane_sum(f);
   if (!std::isfinite(s)) return out;
   if (!(s > 0.0)) {

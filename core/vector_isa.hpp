@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The instruction set of the vectorised loops: the sensor's per-pixel loops (noise rows, ray
-// incidence), the rasteriser's first pass and the point binning's batch pass. Each loop is
-// written once as a plain loop (SONOMAP_VECTOR_LOOP) and compiled three times: for the
-// baseline x86-64 instruction set and, inside SONOMAP_AVX2_KERNEL and SONOMAP_AVX512_KERNEL
-// functions, for AVX2 and AVX-512, chosen at run time (kernel_for). All give the same bits:
+// incidence), the rasteriser's first pass, the point binning's batch pass and the GP kernel
+// sums (core/gp.cpp, in vector types). Each loop is written once (SONOMAP_VECTOR_LOOP) and
+// compiled three times: for the baseline x86-64 instruction set and, inside
+// SONOMAP_AVX2_KERNEL and SONOMAP_AVX512_KERNEL functions, for AVX2 and AVX-512, chosen at run
+// time (kernel_for). All give the same bits:
 // only IEEE basic operations, sqrt and floor, and no fused multiply-add (it rounds once where
 // the baseline rounds twice; "fma" is not in the AVX2 target, and these files build with
 // -ffp-contract=off, so the AVX-512 code, whose instruction set has it, never contracts).

@@ -3,6 +3,7 @@
 // reads the height above the plane; and its SIMD float prediction agrees with the textbook
 // formula evaluated here in double precision (an independent path: Eigen's own solve).
 #include "core/gp.hpp"
+#include "tests/vector_isas.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -80,5 +81,40 @@ TEST_CASE("GP: a point with 1, 3 and 5 training points (not whole SIMD vectors) 
     gp.train(points, GpParams{});
     const Eigen::Vector3d x(0.0, 0.0, 0.03);
     CHECK(gp.predict(x, false).distance == Approx(reference_distance(points, GpParams{}, x)).margin(1e-4));
+  }
+}
+
+TEST_CASE("GP: every instruction set's copy predicts the same bits as the baseline's", "[gp]") {
+  // 1 to 40 points of a curved patch (up to three 16-lane vectors, most of them part full), a
+  // query above it, one beside it and one 30 cm away, for both kernels, with gradient and
+  // variance: the wide copies sum their terms in the baseline's order.
+  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
+    GpParams params;
+    params.kernel = kernel;
+    for (size_t n : {1u, 4u, 15u, 16u, 17u, 33u, 40u}) {
+      std::vector<Eigen::Vector3f> points;
+      for (size_t i = 0; i < n; ++i) {
+        const float u = 0.023f * static_cast<float>(i % 7), v = 0.031f * static_cast<float>(i / 7);
+        points.emplace_back(2.0f + u, -0.5f + v, 0.8f + 0.3f * u * v);
+      }
+      SurfaceGp gp;
+      gp.train(points, params);
+      for (const Eigen::Vector3d& x : {Eigen::Vector3d(2.05, -0.45, 0.83), Eigen::Vector3d(1.9, -0.5, 0.8),
+                                      Eigen::Vector3d(2.3, -0.2, 1.1)}) {
+        auto predicted = [&](VectorIsa isa) {
+          const ScopedVectorIsa code(isa);
+          return gp.predict(x, true, true);
+        };
+        const GpPrediction baseline = predicted(VectorIsa::Baseline);
+        REQUIRE(baseline.valid);
+        for (VectorIsa isa : vector_isas_beside_baseline()) {
+          INFO(name_of(isa) << ", " << n << " points");
+          const GpPrediction copy = predicted(isa);
+          CHECK(std::memcmp(&copy.distance, &baseline.distance, sizeof(double)) == 0);
+          CHECK(std::memcmp(copy.gradient.data(), baseline.gradient.data(), 3 * sizeof(double)) == 0);
+          CHECK(std::memcmp(&copy.variance, &baseline.variance, sizeof(double)) == 0);
+        }
+      }
+    }
   }
 }
