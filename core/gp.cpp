@@ -2,6 +2,8 @@
 #include "core/gp.hpp"
 #include "core/vector_isa.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -185,10 +187,21 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
       k(j, i) = v;
     }
   }
-  llt_.compute(k);
-  alpha_ = llt_.solve(Eigen::VectorXd::Ones(n));
+  const Eigen::LLT<Eigen::MatrixXd> llt(k);
+  const Eigen::VectorXd alpha = llt.solve(Eigen::VectorXd::Ones(n));
   alpha_lanes_.assign(padded, 0.0f);
-  for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha_[i]);
+  for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha[i]);
+  // The Cholesky factor is kept for the variance only, in float and packed: a quarter of the
+  // double matrix (a mapped room's global GPs held 23 MB of factors in double).
+  const Eigen::MatrixXd l = llt.matrixL();
+  lower_.resize(static_cast<size_t>(n) * (n + 1) / 2);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j <= i; ++j) lower_[row_start(i) + j] = static_cast<float>(l(i, j));
+}
+
+size_t SurfaceGp::memory_bytes() const {
+  return points_.capacity() * sizeof(Eigen::Vector3f) +
+         (xs_.capacity() + ys_.capacity() + zs_.capacity() + alpha_lanes_.capacity() + lower_.capacity()) * sizeof(float);
 }
 
 GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance, bool with_gradient) const {
@@ -253,7 +266,14 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
     Eigen::VectorXd kstar(n);
     for (size_t i = 0; i < n; ++i)
       kstar[i] = se ? std::exp(double(expo[i])) : (1.0 + a_ * radius[i]) * std::exp(double(expo[i]));
-    const Eigen::VectorXd v = llt_.matrixL().solve(kstar);
+    // v = L^-1 k* by forward substitution, summed in double; var f = 1 - |v|^2.
+    Eigen::VectorXd v(n);
+    for (size_t i = 0; i < n; ++i) {
+      const float* row = &lower_[row_start(i)];
+      double s = kstar[i];
+      for (size_t j = 0; j < i; ++j) s -= static_cast<double>(row[j]) * v[j];
+      v[i] = s / static_cast<double>(row[i]);
+    }
     const double var_f = std::max(0.0, 1.0 - v.squaredNorm());
     const double f = std::exp(log_f);
     // First-order propagation through d(f): dd/df = -1/(a f d) (SE) or -1/(a f) (Matern).

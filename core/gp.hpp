@@ -6,7 +6,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <Eigen/Cholesky>
 #include <vector>
 
 namespace sonomap {
@@ -41,6 +40,8 @@ class SurfaceGp {
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   // Number of training points (size of the kernel matrix).
   size_t size() const { return points_.size(); }
+  // Heap bytes held (training points, their SIMD copies and weights, the Cholesky factor).
+  size_t memory_bytes() const;
 
   // Distance, gradient (grad d = -grad f / |grad f|) and, if asked, variance at x.
   // f is evaluated relative to its largest kernel term, so far from the points the distance
@@ -58,8 +59,10 @@ class SurfaceGp {
   std::vector<float> xs_, ys_, zs_, alpha_lanes_;
   template <bool kGradient>
   GpPrediction predict_as(const Eigen::Vector3d& x, bool with_variance) const;
-  Eigen::VectorXd alpha_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  // The Cholesky factor L of the kernel matrix (K = L L^T), row i's i + 1 entries from
+  // row_start(i): what the variance needs.
+  std::vector<float> lower_;
+  static size_t row_start(size_t i) { return i * (i + 1) / 2; }
 };
 
 void validate(const GpParams& params);

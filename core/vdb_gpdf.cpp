@@ -1056,7 +1056,7 @@ size_t VdbGpdf::memory_bytes() const {
   for (const auto& kv : global_) {
     const size_t n = kv.second->crossings.size();
     bytes += sizeof(GlobalLeaf) + n * sizeof(Eigen::Vector3f);
-    if (kv.second->gp.trained()) bytes += n * n * sizeof(double) + n * (sizeof(double) + 12);
+    bytes += kv.second->gp.memory_bytes();
   }
   return bytes;
 }
