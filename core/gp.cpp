@@ -193,10 +193,10 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
   for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha[i]);
   // The Cholesky factor is kept for the variance only, in float and packed: a quarter of the
   // double matrix (a mapped room's global GPs held 23 MB of factors in double).
-  const Eigen::MatrixXd l = llt.matrixL();
+  const Eigen::MatrixXd& factor = llt.matrixLLT();  // L in its lower triangle
   lower_.resize(static_cast<size_t>(n) * (n + 1) / 2);
   for (int i = 0; i < n; ++i)
-    for (int j = 0; j <= i; ++j) lower_[row_start(i) + j] = static_cast<float>(l(i, j));
+    for (int j = 0; j <= i; ++j) lower_[row_start(i) + j] = static_cast<float>(factor(i, j));
 }
 
 size_t SurfaceGp::memory_bytes() const {
@@ -222,10 +222,10 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   // Scratch on the stack for the usual sizes (a local GP has at most about 100 points).
   constexpr size_t kOnStack = 256;
   float expo_stack[kOnStack], radius_stack[kOnStack];
-  thread_local std::vector<float> expo_heap, radius_heap;
   float* expo = expo_stack;
   float* radius = radius_stack;
   if (in.padded > kOnStack) {
+    thread_local std::vector<float> expo_heap, radius_heap;  // (a guard per use: here only)
     expo_heap.resize(in.padded);
     radius_heap.resize(in.padded);
     expo = expo_heap.data();

@@ -246,6 +246,8 @@ Eigen::Vector3d centroid(const openvdb::Vec4f& sum) {
 class NormalNeighbourhood {
  public:
   using Leaf = PointSumGrid::TreeType::LeafNodeType;
+  static_assert(Leaf::LOG2DIM == kLeafLog2 && Leaf::DIM > 2 * kNormalReach,
+                "leaf_origin_of() must find this grid's leaves, and the ball span two per axis at most");
   NormalNeighbourhood(const PointSumGrid::ConstAccessor& local, const openvdb::Coord& c)
       : low_(leaf_origin_of(c.offsetBy(-kNormalReach))) {
     const openvdb::Coord high = leaf_origin_of(c.offsetBy(kNormalReach));
@@ -663,7 +665,7 @@ class LeafQueries {
         const openvdb::Coord v = walk.cell();
         // A voxel on the block's edge may round into the neighbour: that block visits it.
         // Observed = active: every fused voxel has weight > 0, and the leaf's mask is 64 bytes
-        // where its values are 4 kB (the values' cache misses were a sixth of carving).
+        // where its values are 4 kB (their cache misses cost about 1 ms of a 5 cm room frame).
         if (leaf_origin_of(v) != block || !leaf->isValueOn(v)) continue;
         cast(v, kFree);
       } while (walk.step());
