@@ -23,29 +23,15 @@ std::vector<Eigen::Vector3f> plane_patch() {
   return points;
 }
 
-// f = k(x)^T (K + noise I)^-1 1 and its distance, written out for the given kernel.
-double reference_distance(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
-  const bool se = p.kernel == GpKernel::RevertingSE;
-  const double a = se ? p.lambda : std::sqrt(3.0 * p.lambda);
-  auto k = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-    const double r = (u - v).norm();
-    return se ? std::exp(-0.5 * a * r * r) : (1.0 + a * r) * std::exp(-a * r);
-  };
-  const int n = static_cast<int>(points.size());
-  Eigen::MatrixXd kk(n, n);
-  Eigen::VectorXd ks(n);
-  for (int i = 0; i < n; ++i) {
-    ks[i] = k(x, points[i].cast<double>());
-    for (int j = 0; j < n; ++j) kk(i, j) = k(points[i].cast<double>(), points[j].cast<double>()) + (i == j ? p.noise : 0.0);
-  }
-  const double f = ks.dot(kk.ldlt().solve(Eigen::VectorXd::Ones(n)));
-  return se ? std::sqrt(2.0 * std::abs(std::log(f)) / a) : std::abs(std::log(f)) / a;
-}
-
-// The distance variance of the same GP: var f = k(x, x) - k*^T (K + noise I)^-1 k* (prior
-// variance 1), through d(f) to first order, dd/df = 1 / (a f d) (SE) or 1 / (a f) (Matern),
-// capped as the GP caps it.
-double reference_variance(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
+// The GP written out in double for the given kernel: f = k*^T (K + noise I)^-1 1 and, with prior
+// variance 1, var f = 1 - k*^T (K + noise I)^-1 k*.
+struct ReferenceGp {
+  bool se;
+  double a;  // kernel rate
+  double f, var_f;
+  double distance() const { return se ? std::sqrt(2.0 * std::abs(std::log(f)) / a) : std::abs(std::log(f)) / a; }
+};
+ReferenceGp reference_gp(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
   const bool se = p.kernel == GpKernel::RevertingSE;
   const double a = se ? p.lambda : std::sqrt(3.0 * p.lambda);
   auto k = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
@@ -60,34 +46,47 @@ double reference_variance(const std::vector<Eigen::Vector3f>& points, const GpPa
     for (int j = 0; j < n; ++j) kk(i, j) = k(points[i].cast<double>(), points[j].cast<double>()) + (i == j ? p.noise : 0.0);
   }
   const Eigen::LDLT<Eigen::MatrixXd> solver(kk);
-  const double f = ks.dot(solver.solve(Eigen::VectorXd::Ones(n)));
-  const double var_f = 1.0 - ks.dot(solver.solve(ks));
-  const double d = reference_distance(points, p, x);
-  const double dd_df = se ? 1.0 / (a * f * d) : 1.0 / (a * f);
-  return std::min(var_f * dd_df * dd_df, p.variance_cap);
+  return {se, a, ks.dot(solver.solve(Eigen::VectorXd::Ones(n))), 1.0 - ks.dot(solver.solve(ks))};
+}
+
+double reference_distance(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
+  return reference_gp(points, p, x).distance();
+}
+
+// The distance variance: var f through d(f) to first order, dd/df = 1 / (a f d) (SE) or
+// 1 / (a f) (Matern), capped as the GP caps it.
+double reference_variance(const std::vector<Eigen::Vector3f>& points, const GpParams& p, const Eigen::Vector3d& x) {
+  const ReferenceGp gp = reference_gp(points, p, x);
+  const double dd_df = gp.se ? 1.0 / (gp.a * gp.f * gp.distance()) : 1.0 / (gp.a * gp.f);
+  return std::min(gp.var_f * dd_df * dd_df, p.variance_cap);
+}
+
+// Trains a GP of each kernel on the plane patch and calls check(gp, params, x) at each query.
+template <typename Check>
+void on_plane_patch(std::initializer_list<Eigen::Vector3d> queries, Check&& check) {
+  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
+    GpParams params;
+    params.kernel = kernel;
+    SurfaceGp gp;
+    gp.train(plane_patch(), params);
+    for (const Eigen::Vector3d& x : queries) check(gp, params, x);
+  }
 }
 
 }  // namespace
 
 TEST_CASE("GP: the distance variance matches the formula in double within 0.01 percent", "[gp]") {
-  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
-    GpParams params;
-    params.kernel = kernel;
-    SurfaceGp gp;
-    const auto points = plane_patch();
-    gp.train(points, params);
-    int below_cap = 0;
-    for (const Eigen::Vector3d& x : {Eigen::Vector3d(3.05, -0.95, 1.21), Eigen::Vector3d(3.11, -0.9, 1.23),
-                                    Eigen::Vector3d(3.02, -0.97, 1.25), Eigen::Vector3d(3.08, -0.92, 1.28),
-                                    Eigen::Vector3d(2.95, -1.05, 1.2)}) {
-      const GpPrediction p = gp.predict(x, true);
-      REQUIRE(p.valid);
-      const double expected = reference_variance(points, params, x);
-      below_cap += expected < params.variance_cap;
-      CHECK(p.variance == Approx(expected).epsilon(1e-4));
-    }
-    CHECK(below_cap >= 2);  // not only the cap compared
-  }
+  int below_cap = 0;
+  on_plane_patch({Eigen::Vector3d(3.05, -0.95, 1.21), Eigen::Vector3d(3.11, -0.9, 1.23), Eigen::Vector3d(3.02, -0.97, 1.25),
+                  Eigen::Vector3d(3.08, -0.92, 1.28), Eigen::Vector3d(2.95, -1.05, 1.2)},
+                 [&](const SurfaceGp& gp, const GpParams& params, const Eigen::Vector3d& x) {
+                   const GpPrediction p = gp.predict(x, true);
+                   REQUIRE(p.valid);
+                   const double expected = reference_variance(plane_patch(), params, x);
+                   below_cap += expected < params.variance_cap;
+                   CHECK(p.variance == Approx(expected).epsilon(1e-4));
+                 });
+  CHECK(below_cap >= 4);  // not only the cap compared (two kernels)
 }
 
 TEST_CASE("GP: over a patch of a plane, a point d above its middle reads d (d up to 6 cm)", "[gp]") {
@@ -102,21 +101,14 @@ TEST_CASE("GP: over a patch of a plane, a point d above its middle reads d (d up
 }
 
 TEST_CASE("GP: the float SIMD prediction matches the formula in double within 0.1 mm", "[gp]") {
-  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
-    GpParams params;
-    params.kernel = kernel;
-    SurfaceGp gp;
-    const auto points = plane_patch();
-    gp.train(points, params);
-    // Above, below, beside and past the patch's corner, near and up to 15 cm away.
-    for (const Eigen::Vector3d& x : {Eigen::Vector3d(3.05, -0.95, 1.23), Eigen::Vector3d(3.11, -0.9, 1.1),
-                                    Eigen::Vector3d(2.95, -1.05, 1.2), Eigen::Vector3d(3.2, -0.8, 1.3),
-                                    Eigen::Vector3d(3.08, -0.92, 1.35)}) {
-      const GpPrediction p = gp.predict(x, false);
-      REQUIRE(p.valid);
-      CHECK(p.distance == Approx(reference_distance(points, params, x)).margin(1e-4));
-    }
-  }
+  // Above, below, beside and past the patch's corner, near and up to 15 cm away.
+  on_plane_patch({Eigen::Vector3d(3.05, -0.95, 1.23), Eigen::Vector3d(3.11, -0.9, 1.1), Eigen::Vector3d(2.95, -1.05, 1.2),
+                  Eigen::Vector3d(3.2, -0.8, 1.3), Eigen::Vector3d(3.08, -0.92, 1.35)},
+                 [](const SurfaceGp& gp, const GpParams& params, const Eigen::Vector3d& x) {
+                   const GpPrediction p = gp.predict(x, false);
+                   REQUIRE(p.valid);
+                   CHECK(p.distance == Approx(reference_distance(plane_patch(), params, x)).margin(1e-4));
+                 });
 }
 
 TEST_CASE("GP: a point with 1, 3 and 5 training points (not whole SIMD vectors) reads its distance", "[gp]") {
