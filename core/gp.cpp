@@ -96,10 +96,12 @@ double lane_sum(Floats v) {
 }
 
 // One prediction's input: the training points relative to the anchor, one array per axis,
-// their weights (padded to kWidest with points 1 km away and weight 0), and the query.
+// their weights (padded to kWidest with points 1 km away and weight 0), and the query. A copy
+// of L lanes reads the count rounded up to L: padding terms are +-0 and leave every sum's bits
+// as they are, so the narrower copies do no more work than their width needs.
 struct KernelInput {
   const float *xs, *ys, *zs, *alpha;
-  size_t padded;
+  size_t count;
   float qx, qy, qz, rate;
   bool se;
 };
@@ -115,8 +117,9 @@ struct KernelSums {
 template <size_t L, bool kGradient>
 SONOMAP_VECTOR_LOOP void sum_kernel_terms(const KernelInput& in, float* expo, float* radius, KernelSums& out) {
   using W = WideFloats<L>;
+  const size_t end = (in.count + L - 1) / L * L;
   W top = W{} - std::numeric_limits<float>::infinity();
-  for (size_t i = 0; i < in.padded; i += L) {
+  for (size_t i = 0; i < end; i += L) {
     const W dx = in.qx - load<L>(in.xs + i), dy = in.qy - load<L>(in.ys + i), dz = in.qz - load<L>(in.zs + i);
     W r = dx * dx + dy * dy + dz * dz;
     if (!in.se)
@@ -130,7 +133,7 @@ SONOMAP_VECTOR_LOOP void sum_kernel_terms(const KernelInput& in, float* expo, fl
   for (size_t j = 1; j < L; ++j) max_expo = top[j] > max_expo ? top[j] : max_expo;
   out.max_expo = max_expo;
   out.f = out.gx = out.gy = out.gz = Floats{};
-  for (size_t i = 0; i < in.padded; i += L) {
+  for (size_t i = 0; i < end; i += L) {
     const W w = load<L>(in.alpha + i) * exp_nonpositive<L>(load<L>(expo + i) - max_expo);
     if constexpr (kGradient) {
       add_by_fours<L>(out.gx, w * (in.qx - load<L>(in.xs + i)));
@@ -216,7 +219,7 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   const bool se = params_.kernel == GpKernel::RevertingSE;
   const Eigen::Vector3d rel = x - anchor_;
   if (!rel.allFinite()) return out;
-  const KernelInput in{xs_.data(), ys_.data(), zs_.data(), alpha_lanes_.data(), xs_.size(),
+  const KernelInput in{xs_.data(), ys_.data(), zs_.data(), alpha_lanes_.data(), n,
                        static_cast<float>(rel.x()), static_cast<float>(rel.y()), static_cast<float>(rel.z()),
                        static_cast<float>(a_), se};
   // Scratch on the stack for the usual sizes (a local GP has at most about 100 points).
@@ -224,10 +227,10 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   float expo_stack[kOnStack], radius_stack[kOnStack];
   float* expo = expo_stack;
   float* radius = radius_stack;
-  if (in.padded > kOnStack) {
+  if (xs_.size() > kOnStack) {
     thread_local std::vector<float> expo_heap, radius_heap;  // (a guard per use: here only)
-    expo_heap.resize(in.padded);
-    radius_heap.resize(in.padded);
+    expo_heap.resize(xs_.size());
+    radius_heap.resize(xs_.size());
     expo = expo_heap.data();
     radius = radius_heap.data();
   }

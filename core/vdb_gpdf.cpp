@@ -93,16 +93,27 @@ class DepthView {
       : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
         usable_(has_depth_image(frame)) {}  // throws when the image is not width x height
 
+  // A world point as the camera sees it: its camera coordinates and its pixel (none outside
+  // the image, or without an image). One projection answers every question about the point.
+  struct Sight {
+    Eigen::Vector3d camera;
+    std::optional<Pixel> pixel;
+  };
+  Sight sight(const Eigen::Vector3d& world) const {
+    Sight s{camera_T_world_ * world, std::nullopt};
+    if (usable_) s.pixel = pixel_of(frame_.intrinsics, frame_.width, frame_.height, s.camera);
+    return s;
+  }
+
   // In the image, and every measured depth of its pixel and the 8 around it is farther.
-  bool seen_in_front(const Eigen::Vector3d& world) const {
+  bool seen_in_front(const Sight& s) const {
     if (!usable_) return true;
-    const Eigen::Vector3d c = camera_T_world_ * world;
-    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
-    if (!px) return false;
-    for (int y = std::max(px->v - 1, 0); y <= std::min(px->v + 1, frame_.height - 1); ++y)
-      for (int x = std::max(px->u - 1, 0); x <= std::min(px->u + 1, frame_.width - 1); ++x) {
+    if (!s.pixel) return false;
+    const Pixel& px = *s.pixel;
+    for (int y = std::max(px.v - 1, 0); y <= std::min(px.v + 1, frame_.height - 1); ++y)
+      for (int x = std::max(px.u - 1, 0); x <= std::min(px.u + 1, frame_.width - 1); ++x) {
         const float d = depth_at(x, y);
-        if (d > 0.0f && d <= c.z()) return false;
+        if (d > 0.0f && d <= s.camera.z()) return false;
       }
     return true;
   }
@@ -120,13 +131,10 @@ class DepthView {
   }
 
   // In the image, and its own pixel measured a surface more than `margin` nearer.
-  bool seen_behind(const Eigen::Vector3d& world, double margin) const {
-    if (!usable_) return false;
-    const Eigen::Vector3d c = camera_T_world_ * world;
-    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, c);
-    if (!px) return false;
-    const float d = depth_at(px->u, px->v);
-    return d > 0.0f && d < c.z() - margin;
+  bool seen_behind(const Sight& s, double margin) const {
+    if (!s.pixel) return false;
+    const float d = depth_at(s.pixel->u, s.pixel->v);
+    return d > 0.0f && d < s.camera.z() - margin;
   }
 
  private:
@@ -731,13 +739,15 @@ void vote_beside_surfaces(const DepthView& view, const openvdb::MaskGrid& near, 
 bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
                   openvdb::Vec4f surface, const LocalGps& locals,
                   const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
-  const Eigen::Vector3d c = voxel_centre(voxel, config.global_voxel);
-  std::optional<bool> in_front;  // view.seen_in_front(c) (9 pixels), asked at most once
+  const Eigen::Vector3d centre = voxel_centre(voxel, config.global_voxel);
+  const DepthView::Sight sight = view.sight(centre);  // projected once for every check below
+  std::optional<bool> in_front;  // view.seen_in_front(sight) (9 pixels), asked at most once
   auto seen_in_front = [&] {
-    if (!in_front) in_front = view.seen_in_front(c);
+    if (!in_front) in_front = view.seen_in_front(sight);
     return *in_front;
   };
-  if (surface[3] > 0 && view.seen_behind(c, kBehindMargin * config.global_voxel)) surface[2] = surface[3] = 0.0f;
+  const bool behind = view.seen_behind(sight, kBehindMargin * config.global_voxel);
+  if (surface[3] > 0 && behind) surface[2] = surface[3] = 0.0f;
   if (votes[kFree] > 0 && near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
@@ -750,7 +760,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
     if (seen_in_front()) {
       votes[kFree] += votes[kFrontInside];
       votes[kFrontInside] = 0;
-    } else if (!view.seen_behind(c, kBehindMargin * config.global_voxel)) {
+    } else if (!behind) {
       votes[kFrontInside] = 0;
     }
   }
@@ -763,7 +773,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // (or for the variance that inverse-variance fusion weights by).
   double distance = 0.0, variance = config.variance_on_surface;
   if (inside + free > 0 || config.inverse_variance_fusion) {
-    const GpPrediction pred = locals.smallest(c, config.inverse_variance_fusion);
+    const GpPrediction pred = locals.smallest(centre, config.inverse_variance_fusion);
     if (!pred.valid) return false;
     distance = pred.distance;
     variance = pred.variance;
@@ -775,7 +785,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   out = {voxel, static_cast<float>(sum / weight),
          static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
          votes[kHitInside] + surface_votes > 0};
-  out.seen_inside = out.hit && out.distance > 0.0f && view.seen_behind(c, kArrivedVoxels * config.global_voxel);
+  out.seen_inside = out.hit && out.distance > 0.0f && view.seen_behind(sight, kArrivedVoxels * config.global_voxel);
   return true;
 }
 
