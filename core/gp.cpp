@@ -36,9 +36,10 @@ double kernel_rate(const GpParams& p) {
 // baseline, 8 with AVX2, 16 with AVX-512) computes the terms; they are summed into four lanes,
 // four terms at a time in the points' order, and the four added up in a fixed order at the
 // end: the sums are those of the 4-lane baseline, to the bit.
-// The wide helpers below take and return 32- and 64-byte vectors; they are always inlined into
-// kernels built for the instruction set that holds them, so no call passes such a vector and
-// GCC's note that their calling convention differs without AVX does not apply.
+// The wide helpers below return 32- and 64-byte vectors (and take them by reference); they are
+// always inlined into kernels built for the instruction set that holds them, so no call
+// passes such a vector and GCC's warning that the calling convention differs without AVX
+// does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
 constexpr size_t kLanes = 4;
 constexpr size_t kWidest = 16;  // the training points are padded to a multiple of this
@@ -63,10 +64,10 @@ SONOMAP_VECTOR_LOOP WideFloats<L> load(const float* p) {
 // e^x for x <= 0 (Cephes' expf polynomial, relative error about 2e-7). Below -87 it gives
 // e^-87 (1.6e-38): kernel terms that small vanish next to the largest, which is 1.
 template <size_t L>
-SONOMAP_VECTOR_LOOP WideFloats<L> exp_nonpositive(WideFloats<L> x) {
+SONOMAP_VECTOR_LOOP WideFloats<L> exp_nonpositive(const WideFloats<L>& exponent) {
   using W = WideFloats<L>;
   const W floor_x = W{} - 87.0f;
-  x = x < floor_x ? floor_x : x;
+  const W x = exponent < floor_x ? floor_x : exponent;
   const W round = W{} + 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
   const W n = (x * 1.44269504088896341f + round) - round;
   const W r = (x - n * 0.693359375f) - n * -2.12194440e-4f;  // ln 2 in two parts
@@ -83,7 +84,7 @@ SONOMAP_VECTOR_LOOP WideFloats<L> exp_nonpositive(WideFloats<L> x) {
 
 // Adds v's lanes to the four of `sum`, four at a time in order.
 template <size_t L>
-SONOMAP_VECTOR_LOOP void add_by_fours(Floats& sum, WideFloats<L> v) {
+SONOMAP_VECTOR_LOOP void add_by_fours(Floats& sum, const WideFloats<L>& v) {
   float lanes[L];
   std::memcpy(lanes, &v, sizeof v);
   for (size_t q = 0; q < L; q += kLanes) sum += load<kLanes>(&lanes[q]);
