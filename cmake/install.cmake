@@ -16,6 +16,10 @@ endforeach()
 set_target_properties(sonomap ${SONOMAP_EXPORTED_TARGETS} PROPERTIES
   INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
 install(TARGETS sonomap RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# Open3D's mapper and readers, which the formats library opens on demand (open3d_module.hpp).
+set_target_properties(sonomap_open3d sonomap_open3d_io PROPERTIES
+  INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
+install(TARGETS sonomap_open3d sonomap_open3d_io LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS ${SONOMAP_EXPORTED_TARGETS} EXPORT sonomapTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

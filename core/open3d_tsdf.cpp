@@ -64,15 +64,6 @@ struct Open3dTsdf::Volume {
   }
 };
 
-void Open3dTsdfConfig::validate() const {
-  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-  auto fail = [](const std::string& what) { throw std::invalid_argument("Open3dTsdfConfig: " + what); };
-  if (!positive(voxel)) fail("voxel must be > 0, got " + std::to_string(voxel));
-  if (!positive(truncation)) fail("truncation must be > 0, got " + std::to_string(truncation));
-  if (!(min_range >= 0.0 && positive(max_range) && min_range < max_range))
-    fail("need 0 <= min_range < max_range");
-}
-
 Open3dTsdf::Open3dTsdf(Open3dTsdfConfig config)
     : config_(validated(config)), volume_(std::make_unique<Volume>(config_)) {}
 

@@ -12,6 +12,7 @@
 #include "core/vector_isa.hpp"
 #include "harness/app/mapper_factory.hpp"
 #include "core/rasterise_map.hpp"
+#include "harness/formats/open3d_module.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"
@@ -21,7 +22,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <omp.h>
-#include <open3d/geometry/KDTreeFlann.h>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 
@@ -118,16 +118,7 @@ struct ReferenceCheck {
 
 double median_nearest_distance(const std::vector<Eigen::Vector3f>& from,
                                const std::vector<Eigen::Vector3f>& to) {
-  if (from.empty() || to.empty()) return NAN;
-  Eigen::MatrixXd points(3, static_cast<Eigen::Index>(to.size()));
-  for (size_t i = 0; i < to.size(); ++i) points.col(static_cast<Eigen::Index>(i)) = to[i].cast<double>();
-  const open3d::geometry::KDTreeFlann tree(points);
-  std::vector<double> distances;
-  distances.reserve(from.size());
-  std::vector<int> index;
-  std::vector<double> distance2;
-  for (const Eigen::Vector3f& p : from)
-    if (tree.SearchKNN(Eigen::Vector3d(p.cast<double>()), 1, index, distance2) == 1) distances.push_back(std::sqrt(distance2[0]));
+  std::vector<double> distances = open3d_functions().nearest_distances(from, to);
   return distances.empty() ? NAN : median(std::move(distances));
 }
 

@@ -4,6 +4,7 @@
 #include "core/depth_only.hpp"
 #include "core/open3d_tsdf.hpp"
 #include "harness/app/config_fields.hpp"
+#include "harness/formats/open3d_module.hpp"
 #include "harness/support/errors.hpp"
 
 #include <cmath>
@@ -76,7 +77,13 @@ std::unique_ptr<Mapper> make_open3d(double voxel, const std::vector<Setting>& se
   Open3dTsdfConfig c = open3d_defaults();
   set_voxel_keeping_truncation(voxel, c.voxel, c.truncation);
   apply(open3d_fields(c), "open3d", settings);
-  return std::make_unique<Open3dTsdf>(c);
+  return open3d_functions().make_mapper(c);
+}
+
+// The open3d mapper's settings. Its class (and its type information) is in the module loaded
+// on demand; asking by name first keeps the module unloaded in runs of the other mappers.
+const Open3dTsdfConfig* open3d_config(const Mapper& mapper) {
+  return mapper.name() == "open3d" ? open3d_functions().config_of(mapper) : nullptr;
 }
 
 // Calls `use(name, table)` with each mapper's table over a config of its defaults.
@@ -114,8 +121,8 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
   } else if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) {
     TsdfConfig c = t->config();
     add(tsdf_fields(c));
-  } else if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) {
-    Open3dTsdfConfig c = o->config();
+  } else if (const auto* o = open3d_config(mapper)) {
+    Open3dTsdfConfig c = *o;
     add(open3d_fields(c));
   } else {
     for (const auto& entry : mapper.config_entries()) entries.push_back(entry);  // registered
@@ -126,7 +133,7 @@ std::vector<std::pair<std::string, std::string>> mapper_config_entries(const Map
 double mapper_voxel(const Mapper& mapper) {
   if (const auto* v = dynamic_cast<const VdbGpdf*>(&mapper)) return v->config().global_voxel;
   if (const auto* t = dynamic_cast<const Tsdf*>(&mapper)) return t->config().voxel;
-  if (const auto* o = dynamic_cast<const Open3dTsdf*>(&mapper)) return o->config().voxel;
+  if (const auto* o = open3d_config(mapper)) return o->voxel;
   for (const auto& [key, value] : mapper.config_entries()) {  // a registered mapper
     char* end = nullptr;
     const double voxel = key == "voxel" ? std::strtod(value.c_str(), &end) : 0.0;

@@ -1,16 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/formats/mesh_io.hpp"
 
+#include "harness/formats/open3d_module.hpp"
 #include "harness/support/errors.hpp"
 
-#include <open3d/geometry/PointCloud.h>
-#include <open3d/geometry/TriangleMesh.h>
-#include <open3d/io/PointCloudIO.h>
-#include <open3d/io/TriangleMeshIO.h>
-#include <open3d/utility/Logging.h>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
 
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <system_error>
 
@@ -38,94 +39,96 @@ void check_readable(const fs::path& file, const std::string& what) {
   }
 }
 
-// Runs an Open3D reader with its logger silenced; fails with our own message naming the file.
-// Open3D reports failures through its logger (warnings) or by throwing.
-template <typename Read>
-void read_quietly(const fs::path& file, const std::string& what, const std::string& formats, Read read) {
-  bool ok = false;
-  std::string reason = "expected " + formats;
-  open3d::utility::VerbosityContextManager silence(open3d::utility::VerbosityLevel::Error);
-  silence.Enter();
-  try {
-    ok = read(file.string());
-  } catch (const std::exception& e) {
-    reason = e.what();
-  }
-  silence.Exit();
-  if (!ok) throw InputError(file.string(), 0, "", "cannot read the " + what + " (" + reason + ")");
+// A binary little-endian PLY file: the header, then each element's records as written by
+// `body` (a few lines of plumbing rather than loading a PLY library for it).
+template <typename Body>
+void write_binary_ply(const fs::path& file, const std::string& elements, Body body) {
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the PLY body is written in host order");
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << "ply\nformat binary_little_endian 1.0\ncomment Created by sonomap\n" << elements
+      << "end_header\n";
+  body(out);
+  out.close();
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+template <typename T>
+void put(std::ostream& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.write(bytes, sizeof(T));
+}
+
+const char* const kVertexElement = "property double x\nproperty double y\nproperty double z\n";
+
+void put_vertices(std::ostream& out, const std::vector<Eigen::Vector3f>& points) {
+  for (const Eigen::Vector3f& p : points)
+    for (int k = 0; k < 3; ++k) put<double>(out, p[k]);
 }
 
 }  // namespace
 
+// Read with assimp (PLY, OBJ, STL and the other formats it knows), polygons split into
+// triangles, node transforms applied, every mesh of the file in one.
 sim::TriangleMesh load_mesh(const fs::path& file) {
   const std::string name = file.string();
   check_readable(file, "mesh");
-  open3d::geometry::TriangleMesh loaded;
-  read_quietly(file, "mesh", "a PLY, OBJ or STL file",
-               [&](const std::string& n) { return open3d::io::ReadTriangleMesh(n, loaded); });
-  if (loaded.triangles_.empty() || loaded.vertices_.empty())
-    throw InputError(name, 0, "", "the mesh has no triangles");
-
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                                     aiProcess_PreTransformVertices |
+                                                     aiProcess_ValidateDataStructure);
+  if (!scene)
+    throw InputError(name, 0, "", std::string("cannot read the mesh (") + importer.GetErrorString() + ")");
   sim::TriangleMesh mesh;
-  mesh.vertices.reserve(loaded.vertices_.size());
-  for (std::size_t i = 0; i < loaded.vertices_.size(); ++i) {
-    const Eigen::Vector3d& v = loaded.vertices_[i];
-    if (!v.allFinite())
-      throw InputError(name, 0, "", "vertex " + std::to_string(i) + " is not finite (NaN or inf)");
-    mesh.vertices.push_back(v.cast<float>());
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh& part = *scene->mMeshes[m];
+    const int first = static_cast<int>(mesh.vertices.size());
+    for (unsigned i = 0; i < part.mNumVertices; ++i) {
+      const aiVector3D& v = part.mVertices[i];
+      const Eigen::Vector3f p(v.x, v.y, v.z);
+      if (!p.allFinite())
+        throw InputError(name, 0, "", "vertex " + std::to_string(mesh.vertices.size()) + " is not finite (NaN or inf)");
+      mesh.vertices.push_back(p);
+    }
+    for (unsigned f = 0; f < part.mNumFaces; ++f) {
+      const aiFace& face = part.mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines: no surface
+      Eigen::Vector3i t;
+      for (int k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= part.mNumVertices)
+          throw InputError(name, 0, "", "triangle " + std::to_string(mesh.triangles.size()) +
+                                            " refers to a vertex that does not exist");
+        t[k] = first + static_cast<int>(face.mIndices[k]);
+      }
+      mesh.triangles.push_back(t);
+    }
   }
-  const int count = static_cast<int>(mesh.vertices.size());
-  mesh.triangles.reserve(loaded.triangles_.size());
-  for (std::size_t i = 0; i < loaded.triangles_.size(); ++i) {
-    const Eigen::Vector3i& t = loaded.triangles_[i];
-    if ((t.array() < 0).any() || (t.array() >= count).any())
-      throw InputError(name, 0, "", "triangle " + std::to_string(i) +
-                                        " refers to a vertex that does not exist");
-    mesh.triangles.push_back(t);
-  }
+  if (mesh.triangles.empty()) throw InputError(name, 0, "", "the mesh has no triangles");
   return mesh;
 }
 
 std::vector<Eigen::Vector3f> load_point_cloud(const fs::path& file) {
   check_readable(file, "point cloud");
-  open3d::geometry::PointCloud loaded;
-  read_quietly(file, "point cloud", "a PLY, PCD or XYZ file",
-               [&](const std::string& n) { return open3d::io::ReadPointCloud(n, loaded); });
-  if (loaded.points_.empty()) throw InputError(file.string(), 0, "", "the point cloud has no points");
-  std::vector<Eigen::Vector3f> points;
-  points.reserve(loaded.points_.size());
-  for (std::size_t i = 0; i < loaded.points_.size(); ++i) {
-    if (!loaded.points_[i].allFinite())
-      throw InputError(file.string(), 0, "", "point " + std::to_string(i) + " is not finite (NaN or inf)");
-    points.push_back(loaded.points_[i].cast<float>());
-  }
-  return points;
+  return open3d_functions().read_point_cloud(file);
 }
 
 void save_point_cloud_ply(const fs::path& file, const std::vector<Eigen::Vector3f>& points) {
-  open3d::geometry::PointCloud cloud;
-  cloud.points_.reserve(points.size());
-  for (const auto& p : points) cloud.points_.push_back(p.cast<double>());
-  open3d::utility::VerbosityContextManager silence(open3d::utility::VerbosityLevel::Error);
-  silence.Enter();
-  const bool ok = open3d::io::WritePointCloud(file.string(), cloud);  // binary, uncompressed
-  silence.Exit();
-  if (!ok) throw std::runtime_error("cannot write the point cloud " + file.string());
+  write_binary_ply(file, "element vertex " + std::to_string(points.size()) + "\n" + kVertexElement,
+                   [&](std::ostream& out) { put_vertices(out, points); });
 }
 
 void save_mesh_ply(const fs::path& file, const std::vector<Eigen::Vector3f>& vertices,
                    const std::vector<Eigen::Vector3i>& triangles) {
-  open3d::geometry::TriangleMesh mesh;
-  mesh.vertices_.reserve(vertices.size());
-  for (const auto& v : vertices) mesh.vertices_.push_back(v.cast<double>());
-  mesh.triangles_ = triangles;
-  open3d::utility::VerbosityContextManager silence(open3d::utility::VerbosityLevel::Error);
-  silence.Enter();
-  const bool ok = open3d::io::WriteTriangleMesh(file.string(), mesh, /*write_ascii=*/false,
-                                                /*compressed=*/false, /*write_vertex_normals=*/false,
-                                                /*write_vertex_colors=*/false);
-  silence.Exit();
-  if (!ok) throw std::runtime_error("cannot write the mesh " + file.string());
+  const std::string elements = "element vertex " + std::to_string(vertices.size()) + "\n" + kVertexElement +
+                               "element face " + std::to_string(triangles.size()) +
+                               "\nproperty list uchar uint vertex_indices\n";
+  write_binary_ply(file, elements, [&](std::ostream& out) {
+    put_vertices(out, vertices);
+    for (const Eigen::Vector3i& t : triangles) {
+      put<std::uint8_t>(out, 3);
+      for (int k = 0; k < 3; ++k) put<std::uint32_t>(out, static_cast<std::uint32_t>(t[k]));
+    }
+  });
 }
 
 }  // namespace sonomap::harness

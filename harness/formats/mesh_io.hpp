@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Mesh files (PLY, OBJ, STL; Open3D's readers) as sim::TriangleMesh.
+// Mesh files (PLY, OBJ, STL and the other formats assimp reads) as sim::TriangleMesh; point
+// clouds through Open3D (loaded on demand: open3d_module.hpp); binary PLY written directly.
 #pragma once
 
 #include "sim/scenario.hpp"
@@ -20,7 +21,7 @@ std::vector<Eigen::Vector3f> load_point_cloud(const std::filesystem::path& file)
 // Writes points as binary PLY (vertices only). Throws std::runtime_error.
 void save_point_cloud_ply(const std::filesystem::path& file, const std::vector<Eigen::Vector3f>& points);
 
-// Writes a mesh as binary PLY with Open3D (the map's surface). Throws std::runtime_error.
+// Writes a mesh as binary PLY (the map's surface). Throws std::runtime_error.
 void save_mesh_ply(const std::filesystem::path& file, const std::vector<Eigen::Vector3f>& vertices,
                    const std::vector<Eigen::Vector3i>& triangles);
 

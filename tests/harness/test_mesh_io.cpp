@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The map's PLY files as another program reads them (Open3D's reader, which shares no code with
+// sonomap's writer), and Open3D loaded only by the runs that use it.
+#include "harness/formats/mesh_io.hpp"
+#include "cli_support.hpp"
+#include "test_scenario_files.hpp"
+
+#include <catch2/catch.hpp>
+#include <open3d/geometry/PointCloud.h>
+#include <open3d/geometry/TriangleMesh.h>
+#include <open3d/io/PointCloudIO.h>
+#include <open3d/io/TriangleMeshIO.h>
+
+#include <cstdlib>
+
+using namespace sonomap;
+using namespace sonomap::test;
+
+namespace {
+
+// A unit tetrahedron 1 km from the origin, so a float's last bits would show in a double.
+const Eigen::Vector3f kOffset(1000.125f, -999.5f, 0.0625f);
+const std::vector<Eigen::Vector3f> kCorners{kOffset, kOffset + Eigen::Vector3f(1, 0, 0),
+                                            kOffset + Eigen::Vector3f(0, 1, 0), kOffset + Eigen::Vector3f(0, 0, 1)};
+const std::vector<Eigen::Vector3i> kFaces{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+
+}  // namespace
+
+TEST_CASE("a mesh written as PLY reads back in Open3D with every vertex and face as written", "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const auto file = dir.path() / "tetra.ply";
+  harness::save_mesh_ply(file, kCorners, kFaces);
+  open3d::geometry::TriangleMesh read;
+  REQUIRE(open3d::io::ReadTriangleMesh(file.string(), read));
+  REQUIRE(read.vertices_.size() == 4);
+  REQUIRE(read.triangles_.size() == 4);
+  for (size_t i = 0; i < 4; ++i) {
+    CHECK(read.vertices_[i] == kCorners[i].cast<double>());  // exact: floats widened to doubles
+    CHECK(read.triangles_[i] == kFaces[i]);
+  }
+  // The tetrahedron's volume, 1/6 m^3, from the faces as read: they keep their winding.
+  double volume = 0.0;
+  for (const auto& t : read.triangles_)
+    volume += (read.vertices_[t[0]] - kOffset.cast<double>())
+                  .dot((read.vertices_[t[1]] - kOffset.cast<double>()).cross(read.vertices_[t[2]] - kOffset.cast<double>())) / 6.0;
+  CHECK(std::abs(volume) == Approx(1.0 / 6.0).epsilon(1e-9));
+}
+
+TEST_CASE("points written as PLY read back in Open3D, in order, exactly", "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const auto file = dir.path() / "points.ply";
+  harness::save_point_cloud_ply(file, kCorners);
+  open3d::geometry::PointCloud read;
+  REQUIRE(open3d::io::ReadPointCloud(file.string(), read));
+  REQUIRE(read.points_.size() == kCorners.size());
+  for (size_t i = 0; i < kCorners.size(); ++i) CHECK(read.points_[i] == kCorners[i].cast<double>());
+}
+
+TEST_CASE("a PLY that cannot be written is an error naming the file, not a silent success", "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const auto file = dir.path() / "missing-folder" / "map.ply";
+  try {
+    harness::save_mesh_ply(file, kCorners, kFaces);
+    FAIL("no error");
+  } catch (const std::runtime_error& e) {
+    CHECK(std::string(e.what()).find("missing-folder/map.ply") != std::string::npos);
+  }
+}
+
+// The dynamic loader's own log (LD_DEBUG=files) lists every library a process opens.
+TEST_CASE("a run of vdb_gpdf on a scene with mesh files never loads Open3D, and a run of open3d does",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const std::string scene = std::string(SONOMAP_SOURCE_DIR) + "/scenes/smoke.yaml";
+  setenv("LD_DEBUG", "files", 1);
+  const CliResult vdb = run_sonomap({"--quiet", "run", scene, "--frames", "2", "--sweeps", "-1",
+                                     "--pictures", "-1", "--out", (dir.path() / "vdb").string()});
+  const CliResult open3d = run_sonomap({"--quiet", "run", scene, "--frames", "2", "--sweeps", "-1",
+                                        "--pictures", "-1", "--mapper", "open3d", "--out",
+                                        (dir.path() / "open3d").string()});
+  unsetenv("LD_DEBUG");
+  REQUIRE(vdb.status == 0);
+  REQUIRE(open3d.status == 0);
+  CHECK(vdb.output.find("file=libassimp") != std::string::npos);  // the person mesh was read
+  CHECK(vdb.output.find("libOpen3D") == std::string::npos);
+  CHECK(open3d.output.find("file=libOpen3D") != std::string::npos);
+}
