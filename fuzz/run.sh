@@ -3,14 +3,14 @@
 # and runs each for SECONDS (default 120) from its seed corpus in fuzz/corpus/<reader>/.
 # New inputs go to build-fuzz/corpus/<reader>/ (the seeds in the repo stay as they are);
 # a crash is saved as build-fuzz/findings/<reader>/crash-* and ends the script with status 1.
-#   fuzz/run.sh [SECONDS] [READER...]     readers: circle_csv scenario_yaml tum sofa rosbag sequence_yaml
+#   fuzz/run.sh [SECONDS] [READER...]     readers: circle_csv scenario_yaml tum sofa rosbag sequence_yaml mesh
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${SONOMAP_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 seconds="${1:-120}"
 shift || true
 readers=("$@")
-[ ${#readers[@]} -eq 0 ] && readers=(circle_csv scenario_yaml tum sofa rosbag sequence_yaml)
+[ ${#readers[@]} -eq 0 ] && readers=(circle_csv scenario_yaml tum sofa rosbag sequence_yaml mesh)
 
 "$root/ci/install-deps" --fuzz
 mkdir -p "$build"

@@ -12,7 +12,7 @@
 #include "core/vector_isa.hpp"
 #include "harness/app/mapper_factory.hpp"
 #include "core/rasterise_map.hpp"
-#include "harness/formats/open3d_module.hpp"
+#include "harness/formats/modules.hpp"
 #include "harness/formats/scenario_yaml.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"

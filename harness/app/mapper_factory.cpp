@@ -4,7 +4,7 @@
 #include "core/depth_only.hpp"
 #include "core/open3d_tsdf.hpp"
 #include "harness/app/config_fields.hpp"
-#include "harness/formats/open3d_module.hpp"
+#include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
 
 #include <cmath>

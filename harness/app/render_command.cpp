@@ -117,15 +117,15 @@ void render_rosbag(const fs::path& scenario_file, const std::vector<std::string>
   const sim::Scenario scenario = load_scenario(scenario_file, overrides);
   const std::unique_ptr<sim::Simulation> simulation = simulation_of(scenario, scenario_file);
   StagedDirectory staged(out, "render", scenario_inputs(scenario, scenario_file));
-  RosbagWriter bag(staged.path() / "data.bag");
+  const std::unique_ptr<RosbagWriter> bag = open_rosbag_writer(staged.path() / "data.bag");
   const int frames = simulation->frame_count();
   Progress progress("render", frames, quiet);
   for (int i = 0; i < frames; ++i) {
     throw_if_interrupted();
-    write_bag_frame(bag, scenario.camera, simulation->render(i));
+    write_bag_frame(*bag, scenario.camera, simulation->render(i));
     progress.update(i + 1);
   }
-  bag.close();
+  bag->close();
   progress.finish();
   save_point_cloud_ply(staged.path() / "truth.ply", static_truth_cloud(scenario, truth_spacing));
   std::ofstream(staged.path() / "sequence.yaml") << rendered_sequence_yaml(scenario);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/formats/mesh_io.hpp"
 
-#include "harness/formats/open3d_module.hpp"
+#include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
 
 #include <assimp/Importer.hpp>

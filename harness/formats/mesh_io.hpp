@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh files (PLY, OBJ, STL and the other formats assimp reads) as sim::TriangleMesh; point
-// clouds through Open3D (loaded on demand: open3d_module.hpp); binary PLY written directly.
+// clouds through Open3D (loaded on demand: modules.hpp); binary PLY written directly.
 #pragma once
 
 #include "sim/scenario.hpp"

@@ -2,6 +2,7 @@
 #include "harness/formats/sofa_io.hpp"
 
 #include "audio/resample.hpp"
+#include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
 #include "harness/support/interrupt.hpp"
 #include "harness/support/output.hpp"
@@ -14,7 +15,6 @@
 #include <map>
 #include <memory>
 #include <mysofa.h>
-#include <netcdf.h>
 
 namespace fs = std::filesystem;
 
@@ -87,16 +87,20 @@ Eigen::Matrix3d head_frame(const MYSOFA_HRTF& h) {
 // Debian's HDF5 1.10 frees an invalid pointer on some corrupt files (found by the sanitizer
 // suite on a mutated default.sofa) and libmysofa can loop on others: the file is first opened
 // by both readers in a child process, so a crash or a hang there becomes a clear error here.
-// A file they refuse cleanly is refused again below, with their message.
-void screen_in_child(const fs::path& file) {
+// netCDF (loaded only in the child, when the file opens: modules.hpp) checks the container
+// before libmysofa reads it: libmysofa 1.3.1 can loop for minutes on a corrupt HDF5 file that
+// netCDF's HDF5 reader refuses at once (found by fuzz/fuzz_sofa). Returns whether both open it.
+bool screen_in_child(const fs::path& file) {
   constexpr double kTimeoutS = 30.0;
-  constexpr int kOpens = 0, kRefused = 10;
+  constexpr int kOpens = 0, kRefused = 10, kNoNetcdf = 11;
   bool timed_out = false;
   const int status = run_isolated(
       [&] {
-        int ncid = 0;
-        if (nc_open(file.c_str(), NC_NOWRITE, &ncid) != NC_NOERR) return kRefused;
-        nc_close(ncid);
+        try {
+          if (netcdf_functions().open_status(file) != 0) return kRefused;
+        } catch (const std::runtime_error&) {
+          return kNoNetcdf;  // the parent loads it again and says why it cannot
+        }
         int err = 0;
         MYSOFA_HRTF* hrtf = mysofa_load(file.c_str(), &err);
         if (hrtf) mysofa_free(hrtf);
@@ -105,9 +109,10 @@ void screen_in_child(const fs::path& file) {
       kTimeoutS, timed_out);
   throw_if_interrupted();
   if (timed_out) bad(file, "the SOFA readers did not finish within 30 s (a corrupt file)");
-  if (status != kOpens && status != kRefused)
+  if (status != kOpens && status != kRefused && status != kNoNetcdf)
     bad(file, "the SOFA readers (HDF5, libmysofa) crashed on it (a corrupt file; exit status " +
                   std::to_string(status) + ")");
+  return status == kOpens;
 }
 
 }  // namespace
@@ -115,13 +120,13 @@ void screen_in_child(const fs::path& file) {
 SofaContents read_sofa(const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) bad(file, "not a readable file");
-  screen_in_child(file);
-  // libmysofa 1.3.1 can loop for minutes on a corrupt HDF5 file (found by fuzz/fuzz_sofa);
-  // netCDF's HDF5 reader refuses such files at once, so it checks the container first.
-  int ncid = 0;
-  if (const int rc = nc_open(file.c_str(), NC_NOWRITE, &ncid); rc != NC_NOERR)
-    bad(file, std::string("not a SOFA (netCDF-4/HDF5) file: ") + nc_strerror(rc));
-  nc_close(ncid);
+  // A file the child's readers refused cleanly is refused again here, with their message:
+  // netCDF's first, so that libmysofa never reads a container netCDF refuses.
+  if (!screen_in_child(file)) {
+    const NetcdfFunctions& netcdf = netcdf_functions();
+    if (const int status = netcdf.open_status(file); status != 0)
+      bad(file, "not a SOFA (netCDF-4/HDF5) file: " + netcdf.status_text(status));
+  }
   int err = 0;
   std::unique_ptr<MYSOFA_HRTF, HrtfDeleter> hrtf(mysofa_load(file.c_str(), &err));
   if (!hrtf || err != MYSOFA_OK) bad(file, "libmysofa cannot load it: " + mysofa_error_name(err));
@@ -330,185 +335,17 @@ audio::BrirSet read_brir_directory(const fs::path& directory, double output_rate
   return assemble(directory, std::move(layers), rate, output_rate);
 }
 
-// ---------------------------------------------------------------------------------------------
-// Writing (netCDF-4)
-
-namespace {
-
-class NetcdfFile {
- public:
-  explicit NetcdfFile(const fs::path& path) : path_(path) {
-    check(nc_create(path.c_str(), NC_NETCDF4 | NC_CLOBBER, &id_), "create");
-  }
-  ~NetcdfFile() {
-    if (id_ >= 0) nc_close(id_);
-  }
-  void check(int status, const std::string& what) const {
-    if (status != NC_NOERR)
-      throw std::runtime_error(path_.string() + ": netCDF " + what + ": " + nc_strerror(status));
-  }
-  int id() const { return id_; }
-  int dim(const char* name, size_t length) {
-    int d = -1;
-    check(nc_def_dim(id_, name, length, &d), std::string("dimension ") + name);
-    return d;
-  }
-  void text(int var, const char* name, const std::string& value) {
-    check(nc_put_att_text(id_, var, name, value.size(), value.c_str()), std::string("attribute ") + name);
-  }
-  int variable(const char* name, std::initializer_list<int> dims) {
-    int v = -1;
-    std::vector<int> d(dims);
-    check(nc_def_var(id_, name, NC_DOUBLE, static_cast<int>(d.size()), d.data(), &v),
-          std::string("variable ") + name);
-    check(nc_def_var_chunking(id_, v, NC_CONTIGUOUS, nullptr), std::string("layout of ") + name);
-    return v;
-  }
-  void put(int var, const std::vector<double>& values) {
-    check(nc_put_var_double(id_, var, values.data()), "write data");
-  }
-  void close() {
-    const int id = id_;
-    id_ = -1;
-    check(nc_close(id), "close");
-  }
-
- private:
-  fs::path path_;
-  int id_ = -1;
-};
-
-}  // namespace
-
 std::string brir_file_name(double distance_m) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "brir_%.2fm.sofa", distance_m);
   return buf;
 }
 
-namespace {
-
-// Head frame -> room frame: the listener's position plus the rotation by the heading.
-Eigen::Vector3d room_position(const SofaMetadata& meta, double azimuth_deg, double distance_m) {
-  const double a = (meta.heading_deg + azimuth_deg) * kPi / 180.0;
-  return meta.listener + distance_m * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0);
-}
-
-void write_globals(NetcdfFile& f, const SofaMetadata& meta) {
-  const std::pair<const char*, std::string> globals[] = {
-      {"Conventions", "SOFA"},
-      {"Version", "2.1"},
-      {"SOFAConventions", "SingleRoomMIMOSRIR"},
-      {"SOFAConventionsVersion", "1.0"},
-      {"DataType", "FIR-E"},
-      {"RoomType", "shoebox"},
-      {"Title", meta.title},
-      // Fixed dates: a file sonomap writes is the same bytes on every run.
-      {"DateCreated", "1970-01-01 00:00:00"},
-      {"DateModified", "1970-01-01 00:00:00"},
-      {"APIName", "sonomap"},
-      {"APIVersion", "0.1"},
-      {"AuthorContact", meta.author_contact},
-      {"Organization", meta.organization},
-      {"License", "GPL-3.0-or-later"},
-      {"ApplicationName", "sonomap brir"},
-      {"ApplicationVersion", "0.1"},
-      {"Comment", meta.comment},
-      {"History", "synthesised by the image-source method with a noise late tail"},
-      {"References", "Allen and Berkley 1979"},
-      {"Origin", "synthetic"},
-      {"DatabaseName", "sonomap"},
-      {"RoomDescription", "shoebox room of the image-source model"},
-      {"ListenerShortName", "KEMAR"},
-      {"ListenerDescription", "head of the HRIR set the responses were synthesised from"},
-      {"SourceDescription", "one source per measurement, on the listener's horizontal plane"}};
-  for (const auto& [name, value] : globals) f.text(NC_GLOBAL, name, value);
-}
-
-}  // namespace
-
-// AES69-2020 SingleRoomMIMOSRIR 1.0: one measurement per source position (M), two receivers
-// (the ears, R), one emitter per source (E), positions in room coordinates.
-static void write_sofa_file(const fs::path& path, double sample_rate, double distance_m,
-                            const std::vector<double>& azimuths,
-                            const std::vector<audio::BinauralIr>& irs, const SofaMetadata& meta) {
-  if (azimuths.empty() || azimuths.size() != irs.size())
-    throw std::invalid_argument("write SOFA: need one IR per azimuth");
-  const size_t m = irs.size(), n = irs.front().left.size();
-  for (const auto& ir : irs)
-    if (ir.left.size() != n || ir.right.size() != n || n == 0)
-      throw std::invalid_argument("write SOFA: IRs of different lengths");
-  NetcdfFile f(path);
-  write_globals(f, meta);
-
-  const int I = f.dim("I", 1), C = f.dim("C", 3), R = f.dim("R", 2), E = f.dim("E", 1);
-  const int N = f.dim("N", n), M = f.dim("M", m);
-  auto position = [&](const char* name, std::initializer_list<int> dims) {
-    const int v = f.variable(name, dims);
-    f.text(v, "Type", "cartesian");
-    f.text(v, "Units", "metre");
-    return v;
-  };
-  const int listener = position("ListenerPosition", {I, C});
-  const int view = position("ListenerView", {I, C});
-  const int up = f.variable("ListenerUp", {I, C});
-  const int receiver = position("ReceiverPosition", {R, C, I});
-  const int source = position("SourcePosition", {M, C});
-  const int source_view = position("SourceView", {M, C});
-  const int source_up = f.variable("SourceUp", {I, C});
-  const int emitter = position("EmitterPosition", {E, C, I});
-  const bool has_room = meta.room_min.allFinite() && meta.room_max.allFinite();
-  int corner_a = -1, corner_b = -1;
-  if (has_room) {
-    const int corners = f.variable("RoomCorners", {I});
-    f.text(corners, "Type", "cartesian");
-    f.text(corners, "Units", "metre");
-    corner_a = f.variable("RoomCornerA", {I, C});
-    corner_b = f.variable("RoomCornerB", {I, C});
-  }
-  const int ir = f.variable("Data.IR", {M, R, N, E});
-  const int rate = f.variable("Data.SamplingRate", {I});
-  f.text(rate, "Units", "hertz");
-  const int delay = f.variable("Data.Delay", {I, R, E});
-  f.check(nc_enddef(f.id()), "end of definitions");
-
-  const Eigen::Vector3d l = meta.listener;
-  const double h = meta.heading_deg * kPi / 180.0;
-  f.put(listener, {l.x(), l.y(), l.z()});
-  f.put(view, {std::cos(h), std::sin(h), 0});
-  f.put(up, {0, 0, 1});
-  f.put(receiver, {0, 0.09, 0, 0, -0.09, 0});  // left ear +y, right ear -y (listener frame)
-  std::vector<double> positions, views;
-  for (double a : azimuths) {
-    const Eigen::Vector3d p = room_position(meta, a, distance_m), towards = (l - p).normalized();
-    positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-    views.insert(views.end(), {towards.x(), towards.y(), towards.z()});  // facing the head
-  }
-  f.put(source, positions);
-  f.put(source_view, views);
-  f.put(source_up, {0, 0, 1});
-  f.put(emitter, {0, 0, 0});
-  if (has_room) {
-    f.put(corner_a, {meta.room_min.x(), meta.room_min.y(), meta.room_min.z()});
-    f.put(corner_b, {meta.room_max.x(), meta.room_max.y(), meta.room_max.z()});
-  }
-  std::vector<double> data;
-  data.reserve(m * 2 * n);
-  for (const auto& pair : irs) {
-    data.insert(data.end(), pair.left.begin(), pair.left.end());
-    data.insert(data.end(), pair.right.begin(), pair.right.end());
-  }
-  f.put(ir, data);
-  f.put(rate, {sample_rate});
-  f.put(delay, {0, 0});
-  f.close();
-}
-
 void write_brir_sofa(const fs::path& file, double sample_rate, double distance_m,
                      const std::vector<double>& azimuths_deg,
                      const std::vector<audio::BinauralIr>& irs, const SofaMetadata& meta) {
   StagedFile staged(file);
-  write_sofa_file(staged.path(), sample_rate, distance_m, azimuths_deg, irs, meta);
+  netcdf_functions().write_brir_sofa(staged.path(), sample_rate, distance_m, azimuths_deg, irs, meta);
   staged.commit();
 }
 
@@ -520,8 +357,8 @@ void write_brir_directory(const fs::path& directory, const audio::BrirSet& set,
     std::vector<audio::BinauralIr> irs;
     for (size_t a = 0; a < na; ++a) irs.push_back(set.at(d, a));
     const double distance = set.grid().distances_m[d];
-    write_sofa_file(staged.path() / brir_file_name(distance), set.sample_rate(), distance,
-                    set.grid().azimuths_deg, irs, meta);
+    netcdf_functions().write_brir_sofa(staged.path() / brir_file_name(distance), set.sample_rate(),
+                                       distance, set.grid().azimuths_deg, irs, meta);
   }
   staged.commit();
 }

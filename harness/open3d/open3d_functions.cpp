@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // libsonomap_open3d_io.so: everything the harness takes from Open3D, behind one entry point
-// (harness/formats/open3d_module.hpp explains why it is loaded on demand).
-#include "harness/formats/open3d_module.hpp"
+// (harness/formats/modules.hpp explains why it is loaded on demand).
+#include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
 
 #include <open3d/geometry/KDTreeFlann.h>

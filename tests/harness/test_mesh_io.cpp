@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The map's PLY files as another program reads them (Open3D's reader, which shares no code with
-// sonomap's writer), and Open3D loaded only by the runs that use it.
+// sonomap's writer), and Open3D, ROS and netCDF loaded only by the runs that use them.
 #include "harness/formats/mesh_io.hpp"
 #include "cli_support.hpp"
 #include "test_scenario_files.hpp"
@@ -12,9 +12,13 @@
 #include <open3d/io/TriangleMeshIO.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
 
 using namespace sonomap;
 using namespace sonomap::test;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -67,21 +71,39 @@ TEST_CASE("a PLY that cannot be written is an error naming the file, not a silen
   }
 }
 
-// The dynamic loader's own log (LD_DEBUG=files) lists every library a process opens.
-TEST_CASE("a run of vdb_gpdf on a scene with mesh files never loads Open3D, and a run of open3d does",
+// The files the dynamic loader opened for the process itself, from its log (LD_DEBUG=files: each
+// line starts with the pid; the first is the program's own, children forked later have others).
+std::string libraries_of_main_process(const std::string& log) {
+  std::istringstream lines(log);
+  std::string line, main_pid, opened;
+  while (std::getline(lines, line)) {
+    const size_t colon = line.find(':'), file = line.find("file=");
+    if (colon == std::string::npos || file == std::string::npos) continue;
+    std::string pid = line.substr(0, colon);
+    pid.erase(0, pid.find_first_not_of(' '));
+    if (main_pid.empty()) main_pid = pid;
+    if (pid == main_pid) opened += line.substr(file) + "\n";
+  }
+  return opened;
+}
+
+TEST_CASE("a run of vdb_gpdf, its sweep and picture included, never loads Open3D, ROS or netCDF",
           "[mesh_io]") {
   ScratchDir dir("mesh-io");
   const std::string scene = std::string(SONOMAP_SOURCE_DIR) + "/scenes/smoke.yaml";
   setenv("LD_DEBUG", "files", 1);
-  const CliResult vdb = run_sonomap({"--quiet", "run", scene, "--frames", "2", "--sweeps", "-1",
-                                     "--pictures", "-1", "--out", (dir.path() / "vdb").string()});
+  const CliResult vdb = run_sonomap({"--quiet", "run", scene, "--frames", "2", "--out", (dir.path() / "vdb").string()});
   const CliResult open3d = run_sonomap({"--quiet", "run", scene, "--frames", "2", "--sweeps", "-1",
                                         "--pictures", "-1", "--mapper", "open3d", "--out",
                                         (dir.path() / "open3d").string()});
   unsetenv("LD_DEBUG");
   REQUIRE(vdb.status == 0);
   REQUIRE(open3d.status == 0);
-  CHECK(vdb.output.find("file=libassimp") != std::string::npos);  // the person mesh was read
-  CHECK(vdb.output.find("libOpen3D") == std::string::npos);
-  CHECK(open3d.output.find("file=libOpen3D") != std::string::npos);
+  REQUIRE(fs::exists(dir.path() / "vdb" / "sweeps"));  // the HRIR set was read for the sweep
+  const std::string vdb_opened = libraries_of_main_process(vdb.output);
+  CHECK(vdb_opened.find("file=libassimp") != std::string::npos);  // the person mesh was read
+  CHECK(vdb_opened.find("libOpen3D") == std::string::npos);
+  CHECK(vdb_opened.find("librosbag") == std::string::npos);
+  CHECK(vdb_opened.find("libnetcdf") == std::string::npos);
+  CHECK(libraries_of_main_process(open3d.output).find("file=libOpen3D") != std::string::npos);
 }

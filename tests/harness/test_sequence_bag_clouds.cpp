@@ -34,16 +34,16 @@ fs::path wall_bag(const fs::path& dir) {
   std::vector<float> depth(16 * 12, 2.0f);
   for (std::size_t k = 0; k < depth.size(); k += 4) depth[k] = 0.0f;
   const fs::path file = dir / "wall.bag";
-  harness::RosbagWriter bag(file);
+  const auto bag = harness::open_rosbag_writer(file);
   for (int i = 0; i < 2; ++i) {
-    bag.camera_info("/camera/info", kStart + i, "camera", camera);
-    bag.depth("/camera/image", kStart + i, "camera", 16, 12, depth);
-    bag.point_cloud("/camera/organised", kStart + i, "camera", camera, depth, true);
-    bag.point_cloud("/camera/unorganised", kStart + i, "camera", camera, depth, false);
+    bag->camera_info("/camera/info", kStart + i, "camera", camera);
+    bag->depth("/camera/image", kStart + i, "camera", 16, 12, depth);
+    bag->point_cloud("/camera/organised", kStart + i, "camera", camera, depth, true);
+    bag->point_cloud("/camera/unorganised", kStart + i, "camera", camera, depth, false);
     // The camera level at the origin, looking along +x (the default mount on a body there).
-    bag.transform("/pose", kStart + i, "world", "camera", sim::CameraSpec::default_body_T_camera());
+    bag->transform("/pose", kStart + i, "world", "camera", sim::CameraSpec::default_body_T_camera());
   }
-  bag.close();
+  bag->close();
   return file;
 }
 
@@ -115,14 +115,14 @@ TEST_CASE("reading a 3000-message bag keeps memory flat", "[sequence][rosbag]") 
   sim::CameraSpec camera;
   camera.width = 64, camera.height = 48, camera.fx = camera.fy = 50.0, camera.cx = 31.5, camera.cy = 23.5;
   {
-    harness::RosbagWriter bag(scratch.path() / "long.bag");
+    const auto bag = harness::open_rosbag_writer(scratch.path() / "long.bag");
     std::vector<float> depth(64 * 48, 2.0f);
     for (int i = 0; i < messages; ++i) {
       const double stamp = kStart + i / 30.0;
-      bag.depth("/depth", stamp, "camera", 64, 48, depth, 1000.0);  // 16UC1 millimetres
-      bag.transform("/pose", stamp, "world", "camera", Eigen::Isometry3d::Identity());
+      bag->depth("/depth", stamp, "camera", 64, 48, depth, 1000.0);  // 16UC1 millimetres
+      bag->transform("/pose", stamp, "world", "camera", Eigen::Isometry3d::Identity());
     }
-    bag.close();
+    bag->close();
   }
   std::ofstream(scratch.path() / "long.yaml")
       << "sequence:\n  source: ros1_bag\n  path: long.bag\n  depth: {topic: /depth, encoding: 16UC1, scale: 1000}\n"

@@ -40,13 +40,13 @@ fs::path tiny_bag(const fs::path& dir, const std::vector<std::pair<double, doubl
   const fs::path file = dir / "tiny.bag";
   sim::CameraSpec camera;
   camera.width = 4, camera.height = 3, camera.fx = camera.fy = 3.0, camera.cx = 1.5, camera.cy = 1.0;
-  harness::RosbagWriter bag(file);
-  bag.camera_info("/camera/depth/camera_info", kStart, "camera", camera);
-  if (camera_info_as_depth) bag.camera_info("/camera/depth/image", kStart, "camera", camera);
+  const auto bag = harness::open_rosbag_writer(file);
+  bag->camera_info("/camera/depth/camera_info", kStart, "camera", camera);
+  if (camera_info_as_depth) bag->camera_info("/camera/depth/image", kStart, "camera", camera);
   for (const auto& [stamp, received] : depth_messages)
-    bag.depth("/camera/depth/image", stamp, "camera", 4, 3, std::vector<float>(12, 2.0f), 0.0, received);
-  for (int i = 0; i < 5; ++i) bag.transform("/vicon/body", kStart + i, "world", "body", Eigen::Isometry3d::Identity());
-  bag.close();
+    bag->depth("/camera/depth/image", stamp, "camera", 4, 3, std::vector<float>(12, 2.0f), 0.0, received);
+  for (int i = 0; i < 5; ++i) bag->transform("/vicon/body", kStart + i, "world", "body", Eigen::Isometry3d::Identity());
+  bag->close();
   return file;
 }
 
