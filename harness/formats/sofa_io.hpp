@@ -3,7 +3,8 @@
 // Reading uses libmysofa's low-level path (mysofa_load + mysofa_check): no loudness
 // normalisation and no interpolation; every measured IR is taken as stored (Data.Delay applied
 // as whole samples) and resampled to the output rate with libsamplerate when the file's differs.
-// Writing uses the netCDF-4 C API, AES69's convention for room responses, SingleRoomMIMOSRIR 1.0
+// Writing uses the netCDF-4 C API (in harness/netcdf/, loaded on demand), AES69's convention
+// for room responses, SingleRoomMIMOSRIR 1.0
 // (DataType FIR-E, RoomType shoebox, positions in room coordinates), in the layout libmysofa
 // 1.3.1 loads: Data.IR contiguous and uncompressed, Data.Delay present, no timestamps.
 // Read back: SimpleFreeFieldHRIR (checked by mysofa_check) or SingleRoomMIMOSRIR (checked
