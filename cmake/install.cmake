@@ -17,10 +17,9 @@ set_target_properties(sonomap ${SONOMAP_EXPORTED_TARGETS} PROPERTIES
   INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
 install(TARGETS sonomap RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The libraries the formats library opens on demand (harness/formats/modules.hpp).
-set(on_demand sonomap_open3d_io sonomap_rosbag_io sonomap_netcdf_io)
-set_target_properties(sonomap_open3d ${on_demand} PROPERTIES
+set_target_properties(sonomap_open3d ${SONOMAP_ON_DEMAND_LIBRARIES} PROPERTIES
   INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
-install(TARGETS sonomap_open3d ${on_demand} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(TARGETS sonomap_open3d ${SONOMAP_ON_DEMAND_LIBRARIES} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS ${SONOMAP_EXPORTED_TARGETS} EXPORT sonomapTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -366,7 +366,7 @@ class BagWriter final : public RosbagWriter {
 
 void BagWriter::depth(const std::string& topic, double stamp, const std::string& frame_id, int width,
                       int height, const std::vector<float>& metres, double units_per_metre,
-                         double received) {
+                      double received) {
   sensor_msgs::Image image;
   image.header.stamp = ros::Time(stamp);
   image.header.frame_id = frame_id;
