@@ -251,40 +251,71 @@ Eigen::Vector3d centroid(const openvdb::Vec4f& sum) {
   return Eigen::Vector3d(sum[0], sum[1], sum[2]) / sum[3];
 }
 
+// One local leaf's occupied local voxels (centroid and the global voxel holding it) in the
+// order of its mask, the global voxels holding its GP training points, and per local voxel
+// its cell's index (-1: no point fell in it).
+struct LeafCells {
+  using Leaf = PointSumGrid::TreeType::LeafNodeType;
+  struct Cell {
+    Eigen::Vector3d centroid;
+    openvdb::Coord global;
+  };
+  std::vector<Cell> cells;
+  std::vector<openvdb::Coord> trained;
+  std::array<int16_t, Leaf::SIZE> cell_of{};  // 1 kB a leaf: no bit counting per probe
+};
+
+// The offsets of the local voxels the PCA normal reads: a ball, not the cube (the cube's
+// corners add a third more probes and bias the neighbourhood toward the grid's diagonals),
+// in x, y, z nested order.
+constexpr int kNormalBall = 57;
+constexpr std::array<std::array<int8_t, 3>, kNormalBall> normal_ball() {
+  std::array<std::array<int8_t, 3>, kNormalBall> ball{};
+  int n = 0;
+  for (int dx = -kNormalReach; dx <= kNormalReach; ++dx)
+    for (int dy = -kNormalReach; dy <= kNormalReach; ++dy)
+      for (int dz = -kNormalReach; dz <= kNormalReach; ++dz)
+        if (dx * dx + dy * dy + dz * dz <= kNormalReach * kNormalReach + 1)
+          ball[n++] = {static_cast<int8_t>(dx), static_cast<int8_t>(dy), static_cast<int8_t>(dz)};
+  return ball;
+}
+
 // The local voxels within kNormalReach of one voxel, read through the (at most 2 x 2 x 2)
 // leaves they span, fetched once: one accessor probing the ball's 57 voxels bounced between
-// leaves, each switch a descent of the tree (about 1 ms of a 5 cm room frame).
+// leaves, each switch a descent of the tree (about 1 ms of a 5 cm room frame). A voxel's
+// centroid is read from its leaf's cells, computed once per frame, not divided out of the
+// point sums again for every source whose ball holds it (2 to 3 ms of a 5 cm room frame).
 class NormalNeighbourhood {
  public:
-  using Leaf = PointSumGrid::TreeType::LeafNodeType;
+  using Leaf = LeafCells::Leaf;
   static_assert(Leaf::LOG2DIM == kLeafLog2 && Leaf::DIM > 2 * kNormalReach,
                 "leaf_origin_of() must find this grid's leaves, and the ball span two per axis at most");
-  NormalNeighbourhood(const PointSumGrid::ConstAccessor& local, const openvdb::Coord& c)
+  NormalNeighbourhood(const std::vector<LeafCells>& cells, const LocalGps::IndexAccessor& index,
+                      const openvdb::Coord& c)
       : low_(leaf_origin_of(c.offsetBy(-kNormalReach))) {
     const openvdb::Coord high = leaf_origin_of(c.offsetBy(kNormalReach));
     for (int i = 0; i < 8; ++i) {
       const openvdb::Coord origin = low_.offsetBy((i & 4) ? Leaf::DIM : 0, (i & 2) ? Leaf::DIM : 0,
                                                   (i & 1) ? Leaf::DIM : 0);
-      const bool spanned = origin.x() <= high.x() && origin.y() <= high.y() && origin.z() <= high.z();
-      leaves_[i] = spanned ? local.probeConstLeaf(origin) : nullptr;
+      if (origin.x() > high.x() || origin.y() > high.y() || origin.z() > high.z()) continue;
+      const int leaf = index.getValue(leaf_key_of(origin));
+      leaves_[i] = leaf >= 0 ? &cells[leaf] : nullptr;
     }
   }
-  // As ConstAccessor::probeValue, for voxels within kNormalReach of the centre.
-  bool probe(const openvdb::Coord& v, openvdb::Vec4f& out) const {
+  // The centroid of the points in local voxel v (within kNormalReach of the centre), or null.
+  const Eigen::Vector3d* centroid(const openvdb::Coord& v) const {
     const int i = ((v.x() - low_.x()) >= static_cast<int>(Leaf::DIM) ? 4 : 0) |
                   ((v.y() - low_.y()) >= static_cast<int>(Leaf::DIM) ? 2 : 0) |
                   ((v.z() - low_.z()) >= static_cast<int>(Leaf::DIM) ? 1 : 0);
-    const Leaf* leaf = leaves_[i];
-    if (!leaf) return false;
-    const openvdb::Index offset = Leaf::coordToOffset(v);
-    if (!leaf->isValueOn(offset)) return false;
-    out = leaf->getValue(offset);
-    return true;
+    const LeafCells* leaf = leaves_[i];
+    if (!leaf) return nullptr;
+    const int cell = leaf->cell_of[Leaf::coordToOffset(v)];
+    return cell < 0 ? nullptr : &leaf->cells[cell].centroid;
   }
 
  private:
   openvdb::Coord low_;
-  std::array<const Leaf*, 8> leaves_{};
+  std::array<const LeafCells*, 8> leaves_{};
 };
 
 // The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
@@ -293,28 +324,23 @@ class NormalNeighbourhood {
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
 // object, and front points land inside it: measured 13 cm deep in a box.)
-Eigen::Vector3d surface_normal(const PointSumGrid::ConstAccessor& accessor, const openvdb::Coord& c,
+Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c,
                                const Eigen::Vector3d& p, const Eigen::Vector3d& u) {
-  const NormalNeighbourhood local(accessor, c);
   // The sums of d and of d d^T's six distinct terms, kept as scalars: Eigen's outer product
   // builds a 3x3 temporary whose partly overlapping stores and loads stalled store-to-load
   // forwarding (13% of this function's samples on one instruction).
   double sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
   int count = 0;
-  for (int dx = -kNormalReach; dx <= kNormalReach; ++dx)
-    for (int dy = -kNormalReach; dy <= kNormalReach; ++dy)
-      for (int dz = -kNormalReach; dz <= kNormalReach; ++dz) {
-        // A ball, not the cube: the cube's corners add a third more probes and bias the
-        // neighbourhood toward the grid's diagonals.
-        if (dx * dx + dy * dy + dz * dz > kNormalReach * kNormalReach + 1) continue;
-        openvdb::Vec4f cell;
-        if (!local.probe(c.offsetBy(dx, dy, dz), cell)) continue;
-        const Eigen::Vector3d d = centroid(cell) - p;  // relative to p: well conditioned
-        sx += d.x(), sy += d.y(), sz += d.z();
-        xx += d.x() * d.x(), xy += d.x() * d.y(), xz += d.x() * d.z();
-        yy += d.y() * d.y(), yz += d.y() * d.z(), zz += d.z() * d.z();
-        ++count;
-      }
+  static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
+  for (const auto& [dx, dy, dz] : kBall) {
+    const Eigen::Vector3d* at = local.centroid(c.offsetBy(dx, dy, dz));
+    if (!at) continue;
+    const Eigen::Vector3d d = *at - p;  // relative to p: well conditioned
+    sx += d.x(), sy += d.y(), sz += d.z();
+    xx += d.x() * d.x(), xy += d.x() * d.y(), xz += d.x() * d.z();
+    yy += d.y() * d.y(), yz += d.y() * d.z(), zz += d.z() * d.z();
+    ++count;
+  }
   if (count < 5) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d mean = Eigen::Vector3d(sx, sy, sz) / count;
   Eigen::Matrix3d outer;
@@ -348,11 +374,12 @@ using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
 using SurfaceVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
 
 // The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
-// GP training points and (after train_local_gps) its GP, and the global voxels near the
-// frame's surface.
+// cells, its GP training points and (after train_local_gps) its GP, and the global voxels near
+// the frame's surface.
 struct LocalFrame {
   PointSumGrid points{openvdb::Vec4f(0.0f)};
   LocalGps gps;
+  std::vector<LeafCells> cells;
   std::vector<std::vector<Eigen::Vector3f>> training;
   // Per local leaf the points queries are placed around: its training points, and one
   // centroid in every global voxel holding frame points in kMinSparseCells local voxels or
@@ -476,22 +503,11 @@ void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& g
   for (PointSumLeaves& bucket : buckets) bucket.move_into(grid);  // leaves in any order: the same tree
 }
 
-// One local leaf's occupied local voxels (centroid and the global voxel holding it) and the
-// global voxels holding its GP training points.
-struct LeafCells {
-  struct Cell {
-    Eigen::Vector3d centroid;
-    openvdb::Coord global;
-  };
-  std::vector<Cell> cells;
-  std::vector<openvdb::Coord> trained;
-};
-
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
 // centroids of every voxel_downsample-th occupied local voxel, not the voxel centres: centres put
 // a face up to half a local voxel inside or outside it), their box, and its cells; then the leaf
 // index and the neighbour links.
-std::vector<LeafCells> index_local_leaves(const VdbGpdfConfig& config, LocalFrame& out) {
+void index_local_leaves(const VdbGpdfConfig& config, LocalFrame& out) {
   std::vector<const PointSumGrid::TreeType::LeafNodeType*> leaves;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   const size_t n = leaves.size();
@@ -501,15 +517,18 @@ std::vector<LeafCells> index_local_leaves(const VdbGpdfConfig& config, LocalFram
   gps.centres.resize(n);
   gps.bounds.resize(n);
   out.training.resize(n);
-  std::vector<LeafCells> cells(n);
+  std::vector<LeafCells>& cells = out.cells;
+  cells.resize(n);
   parallel_for_each_index(n, [&](size_t i) {
     const size_t on = leaves[i]->onVoxelCount();
     cells[i].cells.reserve(on);
     cells[i].trained.reserve(on / config.voxel_downsample + 1);
     out.training[i].reserve(on / config.voxel_downsample + 1);
+    cells[i].cell_of.fill(-1);
     int k = 0;
     for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
       const Eigen::Vector3d c = centroid(*v);
+      cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
       if (k % config.voxel_downsample != 0) continue;
       out.training[i].push_back(c.cast<float>());
@@ -521,7 +540,6 @@ std::vector<LeafCells> index_local_leaves(const VdbGpdfConfig& config, LocalFram
   });
   for (size_t i = 0; i < n; ++i) gps.index.setValue(leaf_key_of(gps.origins[i]), static_cast<int>(i));
   gps.link_neighbours();
-  return cells;
 }
 
 // Per global voxel holding a local voxel's centroid: how many it holds, or -1 when it holds a
@@ -579,7 +597,8 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
 
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
-  const std::vector<LeafCells> cells = index_local_leaves(config, out);
+  index_local_leaves(config, out);
+  const std::vector<LeafCells>& cells = out.cells;
   openvdb::Int32Grid counts(0);
   parallel_both([&] { count_cells(cells, counts); }, [&] { near_surface(cells, out.near); });
   add_sparse_sources(view, cells, counts, out);
@@ -602,7 +621,7 @@ class LeafQueries {
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
               size_t leaf, const Eigen::Vector3d& origin)
       : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
-        observed_(fused.getConstAccessor()), local_acc_(local.points.getConstAccessor()) {}
+        observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index) {}
 
   std::vector<Vote> votes;
 
@@ -611,7 +630,8 @@ class LeafQueries {
     const double range = u.norm();
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
-    const Eigen::Vector3d normal = surface_normal(local_acc_, voxel_of(p, config_.local_voxel), p, u);
+    const openvdb::Coord c = voxel_of(p, config_.local_voxel);
+    const Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u);
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
@@ -688,7 +708,8 @@ class LeafQueries {
   Eigen::Vector3d origin_;
   double vg_;
   DistanceWeightGrid::ConstAccessor observed_;
-  PointSumGrid::ConstAccessor local_acc_;
+  const std::vector<LeafCells>& cells_;
+  LocalGps::IndexAccessor index_;
 };
 
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
