@@ -46,7 +46,7 @@ struct Open3dFunctions {
 struct RosbagFunctions {
   std::unique_ptr<RecordReader> (*open_reader)(const SequenceSpec& spec);
   std::vector<BagTopic> (*list_topics)(const std::filesystem::path& file);
-  std::unique_ptr<RosbagWriter> (*open_writer)(const std::filesystem::path& file);
+  std::unique_ptr<RosbagWriter> (*open_writer)(const std::filesystem::path& file, BagCompression compression);
 };
 
 struct NetcdfFunctions {

@@ -14,8 +14,8 @@ std::vector<BagTopic> list_rosbag_topics(const std::filesystem::path& file) {
   return rosbag_functions().list_topics(file);
 }
 
-std::unique_ptr<RosbagWriter> open_rosbag_writer(const std::filesystem::path& file) {
-  return rosbag_functions().open_writer(file);
+std::unique_ptr<RosbagWriter> open_rosbag_writer(const std::filesystem::path& file, BagCompression compression) {
+  return rosbag_functions().open_writer(file, compression);
 }
 
 }  // namespace sonomap::harness

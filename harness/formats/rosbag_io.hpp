@@ -61,7 +61,11 @@ class RosbagWriter {
   virtual void close() = 0;
 };
 
+// How a bag's chunks are written: as they are (rosbag's default), or compressed as rosbag does.
+enum class BagCompression { None, Lz4, Bz2 };
+
 // Creates (or replaces) the bag `file`. Throws std::runtime_error when it cannot.
-std::unique_ptr<RosbagWriter> open_rosbag_writer(const std::filesystem::path& file);
+std::unique_ptr<RosbagWriter> open_rosbag_writer(const std::filesystem::path& file,
+                                                 BagCompression compression = BagCompression::None);
 
 }  // namespace sonomap::harness

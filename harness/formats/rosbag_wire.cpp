@@ -8,13 +8,15 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <set>
+#include <vector>
+#include <algorithm>
 #include <string>
 
 namespace fs = std::filesystem;
 
 namespace sonomap::harness {
 namespace {
-
 
 std::uint32_t little_endian_u32(const char* bytes) {
   std::uint32_t v = 0;
@@ -74,34 +76,189 @@ std::optional<std::uint64_t> version_200_records(std::ifstream& in) {
   return line.size();
 }
 
+// Where records are read from: the file, or a chunk's (uncompressed) data.
+class FileBytes {
+ public:
+  explicit FileBytes(std::ifstream& in, std::uint64_t size) : in_(in), size_(size) {}
+  std::uint64_t size() const { return size_; }
+  bool read(std::uint64_t at, std::uint64_t n, char* out) {
+    return static_cast<bool>(in_.seekg(static_cast<std::streamoff>(at)).read(out, static_cast<std::streamsize>(n)));
+  }
+
+ private:
+  std::ifstream& in_;
+  std::uint64_t size_;
+};
+
+class MemoryBytes {
+ public:
+  explicit MemoryBytes(const std::string& bytes) : bytes_(bytes) {}
+  std::uint64_t size() const { return bytes_.size(); }
+  bool read(std::uint64_t at, std::uint64_t n, char* out) {
+    if (at > bytes_.size() || n > bytes_.size() - at) return false;
+    std::copy_n(bytes_.data() + at, n, out);
+    return true;
+  }
+
+ private:
+  const std::string& bytes_;
+};
+
+// One record: header length, header ("name=value" fields), data length, data.
+struct Record {
+  std::uint64_t at = 0, data_at = 0, data_length = 0;
+  std::map<std::string, std::string> fields;
+  std::uint64_t end() const { return data_at + data_length; }
+  bool is(char op) const {
+    const auto f = fields.find("op");
+    return f != fields.end() && f->second == std::string(1, op);
+  }
+  // A little-endian field of 4 or 8 bytes; nullopt when absent or of another size.
+  std::optional<std::uint64_t> number(const std::string& name) const {
+    const auto f = fields.find(name);
+    if (f == fields.end() || (f->second.size() != 4 && f->second.size() != 8)) return std::nullopt;
+    std::uint64_t v = little_endian_u32(f->second.data());
+    if (f->second.size() == 8) v |= std::uint64_t{little_endian_u32(f->second.data() + 4)} << 32;
+    return v;
+  }
+};
+
+constexpr char kOpMessage = '\x02', kOpFileHeader = '\x03', kOpIndex = '\x04', kOpChunk = '\x05',
+               kOpChunkInfo = '\x06', kOpConnection = '\x07';
+
+// Reads the record at `at` (not its data); what is wrong with it, if anything.
+template <class Bytes>
+std::optional<std::string> read_record(Bytes& bytes, std::uint64_t at, Record& out) {
+  const std::uint64_t size = bytes.size();
+  char length[4];
+  if (size - at < 4 || !bytes.read(at, 4, length)) return "is cut off";
+  const std::uint64_t header_length = little_endian_u32(length);
+  if (header_length > size - at - 4) return "claims a " + std::to_string(header_length) + "-byte header";
+  std::string header(header_length, '\0');
+  const std::uint64_t data_at = at + 4 + header_length;
+  if (!bytes.read(at + 4, header_length, header.data()) || size - data_at < 4 || !bytes.read(data_at, 4, length))
+    return "is cut off after its header";
+  out.at = at;
+  out.data_at = data_at + 4;
+  out.data_length = little_endian_u32(length);
+  if (out.data_length > size - out.data_at) return "claims " + std::to_string(out.data_length) + " bytes of data";
+  auto fields = header_fields(header);
+  if (!fields) return "has a malformed header (a field runs past its end)";
+  out.fields = std::move(*fields);
+  return std::nullopt;
+}
+
+// A connection record's data are a header of their own (topic, type, definition), which
+// rosbag parses as it parses record headers.
+constexpr const char* kBadConnection = "is a connection whose data (its topic's header) have a field running past their end";
+
+// The offsets in a chunk's uncompressed data from which rosbag reaches a message: a message
+// record's start, or a connection record's whose next record (inside the chunk) reaches one.
+// Every record of the chunk must lie inside it, and every connection's data be a header.
+std::set<std::uint64_t> message_starts(const std::string& chunk, const std::function<void(const std::string&)>& fail) {
+  MemoryBytes bytes(chunk);
+  std::vector<std::pair<std::uint64_t, char>> records;  // start, op
+  for (std::uint64_t at = 0; at < chunk.size();) {
+    Record r;
+    if (const auto problem = read_record(bytes, at, r))
+      fail("holds, at byte " + std::to_string(at) + " of its data, a record that " + *problem);
+    if (r.is(kOpConnection) && !header_fields(chunk.substr(r.data_at, r.data_length)))
+      fail("holds, at byte " + std::to_string(at) + " of its data, a record that " + kBadConnection);
+    records.emplace_back(at, r.is(kOpMessage) ? kOpMessage : r.is(kOpConnection) ? kOpConnection : '\0');
+    at = r.end();
+  }
+  std::set<std::uint64_t> starts;
+  bool next_reaches = false;
+  for (auto r = records.rbegin(); r != records.rend(); ++r) {
+    next_reaches = r->second == kOpMessage || (r->second == kOpConnection && next_reaches);
+    if (next_reaches) starts.insert(r->first);
+  }
+  return starts;
+}
+
+// Index entries (ver 1: sec, nsec, offset; 12 bytes each) must fit in the data, and each
+// offset be in `starts` (the message starts of the chunk before the index; null: not known).
+std::optional<std::string> index_problem(const Record& index, const std::string& data,
+                                         const std::set<std::uint64_t>* starts) {
+  if (index.number("ver") != std::uint64_t{1}) return std::nullopt;  // rosbag refuses it
+  const std::uint64_t count = index.number("count").value_or(0);
+  if (count > data.size() / 12) return "is an index claiming " + std::to_string(count) + " entries";
+  if (!starts) return std::nullopt;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const std::uint64_t offset = little_endian_u32(&data[12 * i + 8]);
+    if (!starts->count(offset))
+      return "is an index whose entry " + std::to_string(i) + " points at byte " + std::to_string(offset) +
+             " of its chunk, where no message starts";
+  }
+  return std::nullopt;
+}
+
+// A chunk's uncompressed data (`data` as read); nullopt when it cannot be had here (another
+// compression, or no inflater).
+std::optional<std::string> chunk_contents(const Record& chunk, std::string data, const ChunkInflater& inflate,
+                                          const std::function<void(const std::string&)>& fail) {
+  const auto field = chunk.fields.find("compression");
+  if (field == chunk.fields.end()) return std::nullopt;  // rosbag refuses the chunk
+  const std::string& compression = field->second;
+  if (compression == "none") return data;
+  if (!inflate || (compression != "lz4" && compression != "bz2")) return std::nullopt;
+  std::string unpacked(*chunk.number("size"), '\0');
+  if (!inflate(compression, data, unpacked))
+    fail("is a chunk whose data do not uncompress (" + compression + ") to the " + std::to_string(unpacked.size()) +
+         " bytes it claims");
+  return unpacked;
+}
+
 }  // namespace
 
-void check_bag_records(const fs::path& file) {
+void check_bag_records(const fs::path& file, const ChunkInflater& inflate) {
   std::ifstream in(file, std::ios::binary);
-  const std::uint64_t size = fs::file_size(file);
+  FileBytes bytes(in, fs::file_size(file));
   const std::optional<std::uint64_t> first_record = version_200_records(in);
   if (!first_record) return;
   auto fail = [&](std::uint64_t at, const std::string& what) {
     throw InputError(file.string(), 0, "",
                      "cannot read the ROS1 bag (truncated or corrupt: try 'rosbag reindex'): the record at byte " +
-                         std::to_string(at) + " " + what + " (the file has " + std::to_string(size) + " bytes)");
+                         std::to_string(at) + " " + what + " (the file has " + std::to_string(bytes.size()) + " bytes)");
   };
-  char length[4];
-  for (std::uint64_t at = *first_record; at < size;) {
-    if (size - at < 4 || !in.seekg(static_cast<std::streamoff>(at)).read(length, 4)) fail(at, "is cut off");
-    const std::uint64_t header_length = little_endian_u32(length);
-    if (header_length > size - at - 4) fail(at, "claims a " + std::to_string(header_length) + "-byte header");
-    std::string header(header_length, '\0');
-    in.read(header.data(), static_cast<std::streamsize>(header_length));
-    const std::uint64_t data_at = at + 4 + header_length;
-    if (size - data_at < 4 || !in.read(length, 4)) fail(at, "is cut off after its header");
-    const std::uint64_t data_length = little_endian_u32(length);
-    if (data_length > size - data_at - 4) fail(at, "claims " + std::to_string(data_length) + " bytes of data");
-    const auto fields = header_fields(header);
-    if (!fields) fail(at, "has a malformed header (a field runs past its end)");
-    if (const auto problem = chunk_problem(*fields, data_length)) fail(at, *problem);
-    at = data_at + 4 + data_length;
+  std::set<std::uint64_t> record_starts, chunk_starts;
+  std::optional<std::set<std::uint64_t>> last_chunk;  // its message starts, if checked
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> index_positions, chunk_positions;  // (record, position)
+  std::string data;
+  for (std::uint64_t at = *first_record; at < bytes.size();) {
+    Record r;
+    if (const auto problem = read_record(bytes, at, r)) fail(at, *problem);
+    record_starts.insert(at);
+    const auto fail_here = [&](const std::string& what) { fail(at, what); };
+    if (r.is(kOpChunk) || r.is(kOpIndex) || r.is(kOpConnection)) {
+      data.resize(r.data_length);
+      if (!bytes.read(r.data_at, r.data_length, data.data())) fail(at, "is cut off in its data");
+    }
+    if (r.is(kOpChunk)) {
+      if (const auto problem = chunk_problem(r.fields, r.data_length)) fail(at, *problem);
+      chunk_starts.insert(at);
+      const std::optional<std::string> contents = chunk_contents(r, std::move(data), inflate, fail_here);
+      last_chunk.reset();
+      if (contents) last_chunk = message_starts(*contents, [&](const std::string& what) { fail(at, "is a chunk that " + what); });
+    } else if (r.is(kOpConnection)) {
+      if (!header_fields(data)) fail(at, kBadConnection);
+    } else if (r.is(kOpIndex)) {
+      if (const auto problem = index_problem(r, data, last_chunk ? &*last_chunk : nullptr)) fail(at, *problem);
+    } else if (r.is(kOpFileHeader)) {
+      index_positions.emplace_back(at, r.number("index_pos").value_or(~std::uint64_t{0}));
+    } else if (r.is(kOpChunkInfo)) {
+      chunk_positions.emplace_back(at, r.number("chunk_pos").value_or(~std::uint64_t{0}));
+    }
+    at = r.end();
   }
+  // rosbag finds the connections and chunk infos at the index position, and the chunks (and
+  // the index records after each) at the chunk infos' positions.
+  for (const auto& [at, index_at] : index_positions)
+    if (index_at != bytes.size() && !record_starts.count(index_at))
+      fail(at, "places the index at byte " + std::to_string(index_at) + ", where no record starts");
+  for (const auto& [at, chunk_at] : chunk_positions)
+    if (!chunk_starts.count(chunk_at))
+      fail(at, "names a chunk at byte " + std::to_string(chunk_at) + ", where none starts");
 }
 
 namespace {

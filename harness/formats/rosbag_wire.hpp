@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <string>
 
 namespace sonomap::harness {
 
@@ -15,12 +17,22 @@ namespace sonomap::harness {
 // and 1 GiB leaves room for any writer's choice and any single message.
 constexpr std::uint32_t kMaxBagMessageBytes = std::uint32_t{1} << 30;
 
-// Every top-level record of a version 2.0 bag (header length, header, data length, data) lies
-// inside the file, every header's fields lie inside it, and a chunk claims no more than
-// kMaxBagMessageBytes uncompressed (exactly its data length when it is not compressed).
-// Throws InputError naming the file and the record's byte offset. Files of another version, or
-// not bags at all, pass (rosbag reports them).
-void check_bag_records(const std::filesystem::path& file);
+// Uncompresses a chunk's data (compression "lz4" or "bz2") into `out`, sized beforehand to
+// the chunk's claimed uncompressed size; false when the data do not uncompress to that size.
+using ChunkInflater = std::function<bool(const std::string& compression, const std::string& packed,
+                                         std::string& out)>;
+
+// What rosbag reads of a version 2.0 bag lies inside what holds it: every top-level record
+// (header length, header, data length, data) inside the file and every header's fields inside
+// the header (a connection's data are a header too: its topic's); a chunk claims no more than kMaxBagMessageBytes uncompressed (exactly its data
+// length when it is not compressed), and its records lie inside it; the file header's index
+// position and every chunk info's chunk position are a record's start; an index record's
+// entries fit in its data, and each points, in the chunk before it, at a record from which
+// rosbag reaches a message (skipping connection records) inside the chunk. Compressed chunks
+// are opened with `inflate` (without one, their insides are not checked). Throws InputError
+// naming the file and the record's byte offset (and the chunk's). Files of another version,
+// or not bags at all, pass (rosbag reports them).
+void check_bag_records(const std::filesystem::path& file, const ChunkInflater& inflate = {});
 
 // The message types sonomap reads from bags.
 enum class BagMessageKind { Image, PointCloud2, CameraInfo, TransformStamped, PoseStamped };

@@ -9,6 +9,8 @@
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <bzlib.h>
+#include <roslz4/lz4s.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -20,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace fs = std::filesystem;
 
@@ -44,13 +47,27 @@ template <>
 struct MessageKind<geometry_msgs::PoseStamped>
     : std::integral_constant<BagMessageKind, BagMessageKind::PoseStamped> {};
 
+// Uncompresses a chunk's data as rosbag does (bzip2, or roslz4's stream format), for the
+// checks of the chunk's records before rosbag reads them (check_bag_records).
+bool inflate_chunk(const std::string& compression, const std::string& packed, std::string& out) {
+  if (packed.size() > std::numeric_limits<unsigned int>::max()) return false;
+  std::string in = packed;  // both libraries take a non-const input
+  unsigned int size = static_cast<unsigned int>(out.size());
+  const auto in_size = static_cast<unsigned int>(in.size());
+  if (compression == "lz4")
+    return roslz4_buffToBuffDecompress(in.data(), in_size, out.data(), &size) == ROSLZ4_OK && size == out.size();
+  if (compression == "bz2")
+    return BZ2_bzBuffToBuffDecompress(out.data(), &size, in.data(), in_size, 0, 0) == BZ_OK && size == out.size();
+  return false;
+}
+
 // The bag, opened for reading, with errors that name it and the topic.
 class BagFile {
  public:
   explicit BagFile(const fs::path& file) : file_(file) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) throw InputError(file.string(), 0, "", "missing or not a regular file");
-    check_bag_records(file);
+    check_bag_records(file, inflate_chunk);
     try {
       bag_.open(file.string(), rosbag::bagmode::Read);
     } catch (const ros::Exception& e) {
@@ -342,9 +359,12 @@ std::vector<BagTopic> list_topics(const fs::path& file) {
 
 class BagWriter final : public RosbagWriter {
  public:
-  explicit BagWriter(const fs::path& file) {
+  BagWriter(const fs::path& file, BagCompression compression) {
     try {
       bag_.open(file.string(), rosbag::bagmode::Write);
+      bag_.setCompression(compression == BagCompression::Lz4   ? rosbag::compression::LZ4
+                          : compression == BagCompression::Bz2 ? rosbag::compression::BZ2
+                                                               : rosbag::compression::Uncompressed);
     } catch (const ros::Exception& e) {
       throw std::runtime_error("cannot create " + file.string() + ": " + e.what());
     }
@@ -467,7 +487,9 @@ void BagWriter::point_cloud(const std::string& topic, double stamp, const std::s
   bag_.write(topic, cloud.header.stamp, cloud);
 }
 
-std::unique_ptr<RosbagWriter> open_writer(const fs::path& file) { return std::make_unique<BagWriter>(file); }
+std::unique_ptr<RosbagWriter> open_writer(const fs::path& file, BagCompression compression) {
+  return std::make_unique<BagWriter>(file, compression);
+}
 
 const RosbagFunctions kFunctions{open_reader, list_topics, open_writer};
 

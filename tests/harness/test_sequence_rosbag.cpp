@@ -36,11 +36,12 @@ std::string sequence_text(const fs::path& bag, const std::string& depth_topic, c
 
 // A 4 x 3 bag whose depth topic holds `depth_messages` (stamp, record time) images at 2 m.
 fs::path tiny_bag(const fs::path& dir, const std::vector<std::pair<double, double>>& depth_messages,
-                  bool camera_info_as_depth = false) {
+                  bool camera_info_as_depth = false,
+                  harness::BagCompression compression = harness::BagCompression::None) {
   const fs::path file = dir / "tiny.bag";
   sim::CameraSpec camera;
   camera.width = 4, camera.height = 3, camera.fx = camera.fy = 3.0, camera.cx = 1.5, camera.cy = 1.0;
-  const auto bag = harness::open_rosbag_writer(file);
+  const auto bag = harness::open_rosbag_writer(file, compression);
   bag->camera_info("/camera/depth/camera_info", kStart, "camera", camera);
   if (camera_info_as_depth) bag->camera_info("/camera/depth/image", kStart, "camera", camera);
   for (const auto& [stamp, received] : depth_messages)
@@ -128,6 +129,42 @@ TEST_CASE("render --format rosbag follows the output rules", "[sequence][rosbag]
   CHECK(fs::exists(scratch.path() / "bag/truth.ply"));
 }
 
+std::uint32_t u32_at(const std::string& bytes, size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+  return v;
+}
+
+// The top-level records of a bag (format 2.0: header length, header, data length, data), by
+// the format's description: where each starts, its op code and where its data are.
+struct BagRecord {
+  size_t at = 0, data_at = 0, data_length = 0;
+  char op = 0;
+};
+std::vector<BagRecord> bag_records(const std::string& bytes) {
+  std::vector<BagRecord> records;
+  for (size_t at = bytes.find('\n') + 1; at + 8 <= bytes.size();) {
+    BagRecord r;
+    r.at = at;
+    const size_t header_length = u32_at(bytes, at);
+    const size_t op = bytes.find(std::string("op=", 3), at + 4);
+    REQUIRE(op < at + 4 + header_length);
+    r.op = bytes[op + 3];
+    r.data_at = at + 8 + header_length;
+    r.data_length = u32_at(bytes, at + 4 + header_length);
+    records.push_back(r);
+    at = r.data_at + r.data_length;
+  }
+  return records;
+}
+
+BagRecord first_record(const fs::path& bag, char op) {
+  for (const BagRecord& r : bag_records(test::text_of(bag)))
+    if (r.op == op) return r;
+  FAIL("no record of op " << int(op));
+  return {};
+}
+
 TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][rosbag]") {
   test::ScratchDir scratch("sequence-rosbag-bad");
   const fs::path sequence = scratch.path() / "sequence.yaml";
@@ -138,8 +175,10 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
   };
   write_sequence("/camera/depth/image");
 
-  SECTION("a good tiny bag runs") {
-    tiny_bag(scratch.path(), {{kStart, 0.0}, {kStart + 1, 0.0}});
+  SECTION("a good tiny bag runs, its chunks compressed or not") {
+    const auto compression = GENERATE(harness::BagCompression::None, harness::BagCompression::Lz4,
+                                      harness::BagCompression::Bz2);
+    tiny_bag(scratch.path(), {{kStart, 0.0}, {kStart + 1, 0.0}}, false, compression);
     CHECK(run_cli(sequence, out).status == 0);
     fs::remove_all(out);
   }
@@ -171,6 +210,59 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     const auto result = run_cli(sequence, out);
     CHECK(result.status == 2);
     CHECK_THAT(result.output, Catch::Contains("the record at byte 24 claims a 4294967280-byte header"));
+  }
+  // Inside a chunk rosbag reads a record where an index entry points, trusting its lengths.
+  SECTION("a record inside a chunk claiming a header past the chunk's end") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const BagRecord chunk = first_record(bag, '\x05');
+    overwrite_u32(bag, chunk.data_at, static_cast<std::uint32_t>(chunk.data_length));  // its first record
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(chunk.at) +
+                                              " is a chunk that holds, at byte 0 of its data, a record that claims a " +
+                                              std::to_string(chunk.data_length) + "-byte header"));
+  }
+  SECTION("an index entry pointing into the middle of a record") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const BagRecord index = first_record(bag, '\x04');
+    overwrite_u32(bag, index.data_at + 8, 1);  // entry 0: sec, nsec, offset in the chunk
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(index.at) +
+                                              " is an index whose entry 0 points at byte 1 of its chunk, where no "
+                                              "message starts"));
+  }
+  SECTION("a connection whose topic header has a field running past its end") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const BagRecord connection = first_record(bag, '\x07');  // the index's, after the chunk
+    overwrite_u32(bag, connection.data_at, static_cast<std::uint32_t>(connection.data_length));
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(connection.at) +
+                                              " is a connection whose data (its topic's header) have a field "
+                                              "running past their end"));
+  }
+  SECTION("a chunk info naming a chunk where none starts") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const BagRecord info = first_record(bag, '\x06');
+    const std::string bytes = test::text_of(bag);
+    const size_t chunk_pos = bytes.find("chunk_pos=", info.at);
+    REQUIRE(chunk_pos < info.data_at);
+    overwrite_u32(bag, chunk_pos + 10, 14);  // one byte into the first record
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(info.at) +
+                                              " names a chunk at byte 14, where none starts"));
+  }
+  SECTION("a compressed chunk whose data do not uncompress") {
+    const auto compression = GENERATE(harness::BagCompression::Lz4, harness::BagCompression::Bz2);
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}}, false, compression);
+    const BagRecord chunk = first_record(bag, '\x05');
+    overwrite_u32(bag, chunk.data_at + chunk.data_length / 2, 0xDEADBEEFu);
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(chunk.at) +
+                                              " is a chunk whose data do not uncompress"));
   }
   SECTION("an image whose pixel count runs past the message") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}, {kStart + 1, 0.0}});
