@@ -174,6 +174,12 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     std::ofstream(sequence) << sequence_text(scratch.path() / "tiny.bag", depth_topic, mount);
   };
   write_sequence("/camera/depth/image");
+  // The run exits 2 naming the record at byte `at` of the bag and what is wrong with it.
+  const auto expect_record_refused = [&](size_t at, const std::string& what) {
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(at) + " " + what));
+  };
 
   SECTION("a good tiny bag runs, its chunks compressed or not") {
     const auto compression = GENERATE(harness::BagCompression::None, harness::BagCompression::Lz4,
@@ -216,31 +222,21 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
     const BagRecord chunk = first_record(bag, '\x05');
     overwrite_u32(bag, chunk.data_at, static_cast<std::uint32_t>(chunk.data_length));  // its first record
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(chunk.at) +
-                                              " is a chunk that holds, at byte 0 of its data, a record that claims a " +
-                                              std::to_string(chunk.data_length) + "-byte header"));
+    expect_record_refused(chunk.at, "is a chunk that holds, at byte 0 of its data, a record that claims a " +
+                                        std::to_string(chunk.data_length) + "-byte header");
   }
   SECTION("an index entry pointing into the middle of a record") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
     const BagRecord index = first_record(bag, '\x04');
     overwrite_u32(bag, index.data_at + 8, 1);  // entry 0: sec, nsec, offset in the chunk
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(index.at) +
-                                              " is an index whose entry 0 points at byte 1 of its chunk, where no "
-                                              "message starts"));
+    expect_record_refused(index.at, "is an index whose entry 0 points at byte 1 of its chunk, where no message starts");
   }
   SECTION("a connection whose topic header has a field running past its end") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
     const BagRecord connection = first_record(bag, '\x07');  // the index's, after the chunk
     overwrite_u32(bag, connection.data_at, static_cast<std::uint32_t>(connection.data_length));
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(connection.at) +
-                                              " is a connection whose data (its topic's header) have a field "
-                                              "running past their end"));
+    expect_record_refused(connection.at,
+                          "is a connection whose data (its topic's header) have a field running past their end");
   }
   SECTION("a chunk info naming a chunk where none starts") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
@@ -249,20 +245,14 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     const size_t chunk_pos = bytes.find("chunk_pos=", info.at);
     REQUIRE(chunk_pos < info.data_at);
     overwrite_u32(bag, chunk_pos + 10, 14);  // one byte into the first record
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(info.at) +
-                                              " names a chunk at byte 14, where none starts"));
+    expect_record_refused(info.at, "names a chunk at byte 14, where none starts");
   }
   SECTION("a compressed chunk whose data do not uncompress") {
     const auto compression = GENERATE(harness::BagCompression::Lz4, harness::BagCompression::Bz2);
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}}, false, compression);
     const BagRecord chunk = first_record(bag, '\x05');
     overwrite_u32(bag, chunk.data_at + chunk.data_length / 2, 0xDEADBEEFu);
-    const auto result = run_cli(sequence, out);
-    CHECK(result.status == 2);
-    CHECK_THAT(result.output, Catch::Contains("the record at byte " + std::to_string(chunk.at) +
-                                              " is a chunk whose data do not uncompress"));
+    expect_record_refused(chunk.at, "is a chunk whose data do not uncompress");
   }
   SECTION("an image whose pixel count runs past the message") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}, {kStart + 1, 0.0}});
