@@ -54,24 +54,35 @@ std::optional<std::string> chunk_problem(const std::map<std::string, std::string
          std::to_string(data_length);
 }
 
-// rosbag reads a bag's first line with fgets into 1024 bytes (so the records start after at
-// most 1023 characters, the newline included), its version from that line as
-// "#ROS<type> V<major>.<minor>" with a type of under 100 characters, and takes
-// major * 100 + minor = 200 as version 2.0. Returns where the records start when rosbag will
-// read the file as version 2.0, nullopt when it will not (rosbag then reports it).
-std::optional<std::uint64_t> version_200_records(std::ifstream& in) {
+// rosbag reads a bag's first line with fgets into 1024 bytes and counts it to its first NUL,
+// so the records start after at most 1023 characters, after the newline or at a NUL. It reads
+// the version from that line with sscanf's "#ROS%s V%d.%d", the type into 100 bytes (%s
+// skips white space, then takes a word of any length), and takes major * 100 + minor = 200
+// as version 2.0. Returns where the records start when rosbag will read the file as version
+// 2.0, nullopt when it will not (rosbag then reports it). Throws InputError when the type is
+// too long for rosbag's buffer.
+std::optional<std::uint64_t> version_200_records(std::ifstream& in, const fs::path& file) {
   constexpr size_t kLineBuffer = 1024, kTypeBuffer = 100;
   std::string line(kLineBuffer - 1, '\0');
   in.read(line.data(), static_cast<std::streamsize>(line.size()));
   line.resize(static_cast<size_t>(in.gcount()));
   in.clear();
   if (const size_t newline = line.find('\n'); newline != std::string::npos) line.resize(newline + 1);
+  line.resize(std::min(line.size(), line.find('\0')));
   if (line.rfind("#ROS", 0) != 0) return std::nullopt;
-  size_t type_end = 4;
-  while (type_end < line.size() && !std::isspace(static_cast<unsigned char>(line[type_end]))) ++type_end;
+  const auto space = [&](size_t i) { return std::isspace(static_cast<unsigned char>(line[i])) != 0; };
+  size_t type_begin = 4;
+  while (type_begin < line.size() && space(type_begin)) ++type_begin;
+  size_t type_end = type_begin;
+  while (type_end < line.size() && !space(type_end)) ++type_end;
+  if (type_end - type_begin >= kTypeBuffer)
+    throw InputError(file.string(), 1, "",
+                     "not a ROS1 bag rosbag can read: the version line's log type is " +
+                         std::to_string(type_end - type_begin) + " characters long (rosbag reads at most " +
+                         std::to_string(kTypeBuffer - 1) + ")");
   int major = 0, minor = 0;
-  if (type_end - 4 >= kTypeBuffer ||
-      std::sscanf(line.c_str() + type_end, " V%d.%d", &major, &minor) != 2 || major * 100 + minor != 200)
+  if (type_end == type_begin || std::sscanf(line.c_str() + type_end, " V%d.%d", &major, &minor) != 2 ||
+      major * 100 + minor != 200)
     return std::nullopt;
   return line.size();
 }
@@ -214,7 +225,7 @@ std::optional<std::string> chunk_contents(const Record& chunk, std::string data,
 void check_bag_records(const fs::path& file, const ChunkInflater& inflate) {
   std::ifstream in(file, std::ios::binary);
   FileBytes bytes(in, fs::file_size(file));
-  const std::optional<std::uint64_t> first_record = version_200_records(in);
+  const std::optional<std::uint64_t> first_record = version_200_records(in, file);
   if (!first_record) return;
   auto fail = [&](std::uint64_t at, const std::string& what) {
     throw InputError(file.string(), 0, "",

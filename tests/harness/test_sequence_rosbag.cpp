@@ -217,6 +217,33 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     CHECK(result.status == 2);
     CHECK_THAT(result.output, Catch::Contains("the record at byte 24 claims a 4294967280-byte header"));
   }
+  // rosbag reads the version line with sscanf("#ROS%s V%d.%d"), whose %s skips white space
+  // and takes a word of any length into 100 bytes, and counts the line to its first NUL.
+  SECTION("a version line with white space before its log type is a bag, checked like any") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const std::string bytes = test::text_of(bag);
+    std::ofstream(bag, std::ios::binary | std::ios::trunc) << "#ROS \tBAG V2.0\n" << bytes.substr(13);
+    overwrite_u32(bag, 15, 0xFFFFFFF0u);  // the first record's header length
+    expect_record_refused(15, "claims a 4294967280-byte header");
+  }
+  SECTION("a version line whose log type would overflow rosbag's buffer") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const std::string bytes = test::text_of(bag);
+    std::ofstream(bag, std::ios::binary | std::ios::trunc) << "#ROS" << std::string(120, 'x') << " V2.0\n"
+                                                           << bytes.substr(13);
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("tiny.bag") &&
+                                  Catch::Contains("the version line's log type is 120 characters long"));
+  }
+  SECTION("a NUL in the version line: the records start there, as rosbag counts") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const std::string bytes = test::text_of(bag);
+    std::ofstream(bag, std::ios::binary | std::ios::trunc) << bytes.substr(0, 12) << std::string(1, '\0')
+                                                           << bytes.substr(12);
+    // rosbag reads a record at byte 12: the NUL, the newline and the first record's length.
+    expect_record_refused(12, "claims a " + std::to_string(0x0A00u | (u32_at(bytes, 13) << 16)) + "-byte header");
+  }
   // Inside a chunk rosbag reads a record where an index entry points, trusting its lengths.
   SECTION("a record inside a chunk claiming a header past the chunk's end") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
