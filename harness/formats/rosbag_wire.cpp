@@ -59,8 +59,8 @@ std::optional<std::string> chunk_problem(const std::map<std::string, std::string
 // the version from that line with sscanf's "#ROS%s V%d.%d", the type into 100 bytes (%s
 // skips white space, then takes a word of any length), and takes major * 100 + minor = 200
 // as version 2.0. Returns where the records start when rosbag will read the file as version
-// 2.0, nullopt when it will not (rosbag then reports it). Throws InputError when the type is
-// too long for rosbag's buffer.
+// 2.0, nullopt when it is no bag (rosbag then reports it). Throws InputError when the type is
+// too long for rosbag's buffer, or the bag is of another format.
 std::optional<std::uint64_t> version_200_records(std::ifstream& in, const fs::path& file) {
   constexpr size_t kLineBuffer = 1024, kTypeBuffer = 100;
   std::string line(kLineBuffer - 1, '\0');
@@ -81,9 +81,13 @@ std::optional<std::uint64_t> version_200_records(std::ifstream& in, const fs::pa
                          std::to_string(type_end - type_begin) + " characters long (rosbag reads at most " +
                          std::to_string(kTypeBuffer - 1) + ")");
   int major = 0, minor = 0;
-  if (type_end == type_begin || std::sscanf(line.c_str() + type_end, " V%d.%d", &major, &minor) != 2 ||
-      major * 100 + minor != 200)
+  if (type_end == type_begin || std::sscanf(line.c_str() + type_end, " V%d.%d", &major, &minor) != 2)
     return std::nullopt;
+  // rosbag also reads the format of 2009 (1.2), by code these checks do not cover.
+  if (major * 100 + minor != 200)
+    throw InputError(file.string(), 1, "",
+                     "bag format " + std::to_string(major) + "." + std::to_string(minor) +
+                         " is not read here: only format 2.0 (rosbag's since 2010)");
   return line.size();
 }
 

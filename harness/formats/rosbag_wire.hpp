@@ -30,8 +30,8 @@ using ChunkInflater = std::function<bool(const std::string& compression, const s
 // entries fit in its data, and each points, in the chunk before it, at a record from which
 // rosbag reaches a message (skipping connection records) inside the chunk. Compressed chunks
 // are opened with `inflate` (without one, their insides are not checked). Throws InputError
-// naming the file and the record's byte offset (and the chunk's). Files of another version,
-// or not bags at all, pass (rosbag reports them).
+// naming the file and the record's byte offset (and the chunk's), or the version line for a
+// bag of another format than 2.0. Files that are not bags at all pass (rosbag reports them).
 void check_bag_records(const std::filesystem::path& file, const ChunkInflater& inflate = {});
 
 // The message types sonomap reads from bags.

@@ -236,6 +236,14 @@ TEST_CASE("bad ROS1 bags fail naming the topic and the message", "[sequence][ros
     CHECK_THAT(result.output, Catch::Contains("tiny.bag") &&
                                   Catch::Contains("the version line's log type is 120 characters long"));
   }
+  SECTION("a bag of the older format 1.2 is refused, not read unchecked") {
+    const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
+    const std::string bytes = test::text_of(bag);
+    std::ofstream(bag, std::ios::binary | std::ios::trunc) << "#ROSRECORD V1.2\n" << bytes.substr(13);
+    const auto result = run_cli(sequence, out);
+    CHECK(result.status == 2);
+    CHECK_THAT(result.output, Catch::Contains("tiny.bag") && Catch::Contains("bag format 1.2 is not read here"));
+  }
   SECTION("a NUL in the version line: the records start there, as rosbag counts") {
     const fs::path bag = tiny_bag(scratch.path(), {{kStart, 0.0}});
     const std::string bytes = test::text_of(bag);
