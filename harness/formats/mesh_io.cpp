@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <system_error>
 
 namespace fs = std::filesystem;
@@ -36,6 +38,71 @@ void check_readable(const fs::path& file, const std::string& what) {
     in.read(magic, 4);
     if (std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
       throw InputError(name, 1, "", "not a PLY file (it does not start with 'ply')");
+  }
+}
+
+// The fewest bytes a PLY property takes per element: in ASCII one character, in binary its
+// type's size (a list at least its count). 0 for a type PLY does not define.
+std::uint64_t ply_property_bytes(bool ascii, const std::string& type) {
+  if (ascii) return 1;
+  static const std::map<std::string, std::uint64_t> kSizes = {
+      {"char", 1},  {"uchar", 1},  {"int8", 1},  {"uint8", 1},   {"short", 2},   {"ushort", 2},
+      {"int16", 2}, {"uint16", 2}, {"int", 4},   {"uint", 4},    {"int32", 4},   {"uint32", 4},
+      {"float", 4}, {"float32", 4}, {"double", 8}, {"float64", 8}};
+  const auto size = kSizes.find(type);
+  return size == kSizes.end() ? 0 : size->second;
+}
+
+// Assimp's PLY reader sizes its arrays by the header's element counts before it reads the
+// elements: a 2 kB file claiming 100 million vertices kept it busy for minutes and gigabytes
+// (fuzz/fuzz_mesh). So the counts must fit in the bytes after the header, each element
+// taking at least ply_property_bytes() per property. Files that do not start like a PLY, or
+// whose header is unreadable, are left to assimp.
+void check_ply_counts(const fs::path& file) {
+  constexpr std::size_t kMaxHeader = 1 << 16;
+  std::ifstream in(file, std::ios::binary);
+  std::string head(kMaxHeader, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const std::size_t end = head.find("end_header");
+  if (head.rfind("ply", 0) != 0 || end == std::string::npos) return;
+  const std::size_t body_at = head.find('\n', end);
+  if (body_at == std::string::npos) return;
+  struct Element {
+    std::string name;
+    std::uint64_t count = 0, bytes = 0;
+    int line = 0;
+  };
+  std::vector<Element> elements;
+  bool ascii = true;
+  std::istringstream lines(head.substr(0, end));
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    std::istringstream words(line);
+    std::string word, type;
+    words >> word;
+    if (word == "format") {
+      words >> type;
+      ascii = type == "ascii";
+    } else if (word == "element") {
+      Element e;
+      e.line = number;
+      if (!(words >> e.name >> e.count)) return;
+      elements.push_back(e);
+    } else if (word == "property" && !elements.empty() && words >> type) {
+      if (type == "list" && !(words >> type)) return;  // the list's count type
+      elements.back().bytes += ply_property_bytes(ascii, type);
+    }
+  }
+  std::uint64_t left = fs::file_size(file) - (body_at + 1);
+  for (const Element& e : elements) {
+    if (e.bytes == 0) continue;
+    if (e.count > left / e.bytes)
+      throw InputError(file.string(), e.line, "element " + e.name,
+                       "the header claims " + std::to_string(e.count) + " elements of at least " +
+                           std::to_string(e.bytes) + " bytes each; the " + std::to_string(left) +
+                           " bytes left after the header cannot hold them");
+    left -= e.count * e.bytes;
   }
 }
 
@@ -73,6 +140,7 @@ void put_vertices(std::ostream& out, const std::vector<Eigen::Vector3f>& points)
 sim::TriangleMesh load_mesh(const fs::path& file) {
   const std::string name = file.string();
   check_readable(file, "mesh");
+  check_ply_counts(file);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                                      aiProcess_PreTransformVertices |

@@ -7,9 +7,9 @@
 #include "harness/formats/rosbag_wire.hpp"
 #include "harness/support/errors.hpp"
 
+#include <bzlib.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
-#include <bzlib.h>
 #include <roslz4/lz4s.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>

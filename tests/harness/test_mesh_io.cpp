@@ -116,3 +116,26 @@ TEST_CASE("an STL file cut off inside a facet is refused naming the file", "[mes
   const std::string message = input_error_of([&] { harness::load_mesh(file); });
   CHECK(message.find("cut.stl") != std::string::npos);
 }
+
+// Assimp sizes its arrays by a PLY header's counts before reading: 100 million vertices
+// claimed by a 200-byte file took it minutes and gigabytes (fuzz/fuzz_mesh).
+TEST_CASE("a PLY whose header claims more elements than its bytes can hold is refused naming the line",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex ";
+  const std::string rest = "\nproperty float x\nproperty float y\nproperty float z\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  // Three vertices of three properties, and a face: 3 x 3 + 1 = 10 bytes at least, 26 here.
+  CHECK_NOTHROW(harness::load_mesh(dir.write("three.ply", header + "3" + rest)));
+  const std::string message =
+      input_error_of([&] { harness::load_mesh(dir.write("claims.ply", header + "100000000" + rest)); });
+  CHECK(message.find("claims.ply:3: key 'element vertex'") != std::string::npos);
+  CHECK(message.find("claims 100000000 elements of at least 3 bytes each") != std::string::npos);
+  // Binary: a vertex of three floats is 12 bytes, so 3 vertices need 36 bytes after the header.
+  const std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n";
+  const std::string cut =
+      input_error_of([&] { harness::load_mesh(dir.write("cut.ply", binary + std::string(35, '\0'))); });
+  CHECK(cut.find("the 35 bytes left after the header cannot hold them") != std::string::npos);
+}
