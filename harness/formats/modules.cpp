@@ -3,6 +3,7 @@
 
 #include <dlfcn.h>
 
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -10,16 +11,28 @@ namespace sonomap::harness {
 
 namespace {
 
-// dlopen searches the RUNPATH of the library that calls it, this one: the build tree's harness
-// folder, or the installed library folder. So the modules are found wherever sonomap's own
-// libraries are. The table's type is the one the module was built with (same build).
+// The modules lie beside this library, in the build tree (harness/) and installed (lib/),
+// and are opened by their full path there. A bare name would be looked up through the RUNPATH
+// of the library calling dlopen, which is not this one under the sanitizers: their dlopen
+// interceptor calls dlopen from their own runtime, and every sanitizer run that needed a
+// module failed to find it. The table's type is the one the module was built with (same build).
+std::string beside_this_library(const char* library) {
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void*>(&beside_this_library), &info) != 0 && info.dli_fname != nullptr) {
+    const std::filesystem::path self(info.dli_fname);
+    if (self.has_parent_path()) return (self.parent_path() / library).string();
+  }
+  return library;
+}
+
 template <typename Table>
 const Table* load(const char* library, const char* entry_name) {
-  void* module = dlopen(library, RTLD_NOW | RTLD_LOCAL);
-  if (!module) throw std::runtime_error(std::string("cannot load ") + library + ": " + dlerror());
+  const std::string path = beside_this_library(library);
+  void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!module) throw std::runtime_error("cannot load " + path + ": " + dlerror());
   using Entry = const Table* (*)();
   const auto entry = reinterpret_cast<Entry>(dlsym(module, entry_name));
-  if (!entry) throw std::runtime_error(std::string(library) + " has no " + entry_name + ": " + dlerror());
+  if (!entry) throw std::runtime_error(path + " has no " + entry_name + ": " + dlerror());
   return entry();
 }
 
