@@ -41,10 +41,8 @@ void check_readable(const fs::path& file, const std::string& what) {
   }
 }
 
-// The fewest bytes a PLY property takes per element: in ASCII one character, in binary its
-// type's size (a list at least its count). 0 for a type PLY does not define.
-std::uint64_t ply_property_bytes(bool ascii, const std::string& type) {
-  if (ascii) return 1;
+// The bytes of a PLY scalar type; 0 for a type PLY does not define.
+std::uint64_t ply_type_bytes(const std::string& type) {
   static const std::map<std::string, std::uint64_t> kSizes = {
       {"char", 1},  {"uchar", 1},  {"int8", 1},  {"uint8", 1},   {"short", 2},   {"ushort", 2},
       {"int16", 2}, {"uint16", 2}, {"int", 4},   {"uint", 4},    {"int32", 4},   {"uint32", 4},
@@ -53,21 +51,25 @@ std::uint64_t ply_property_bytes(bool ascii, const std::string& type) {
   return size == kSizes.end() ? 0 : size->second;
 }
 
-// Assimp's PLY reader sizes its arrays by the header's element counts before it reads the
-// elements: a 2 kB file claiming 100 million vertices kept it busy for minutes and gigabytes
-// (fuzz/fuzz_mesh). So the counts must fit in the bytes after the header, each element
-// taking at least ply_property_bytes() per property. Files that do not start like a PLY, or
-// whose header is unreadable, are left to assimp.
-void check_ply_counts(const fs::path& file) {
+// Assimp's PLY reader trusts the header: it sizes its arrays by the element counts before it
+// reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
+// gigabytes), and it crashed on a header without its end_header line (fuzz/fuzz_mesh). So a
+// file that starts like a PLY must have a header that ends within 64 kB, elements with a name
+// and a count, properties of PLY's types, and counts that fit in the bytes after the header
+// (each element at least one byte per property in ASCII, its properties' sizes in binary, a
+// list at least its count). Refused naming the line.
+void check_ply_header(const fs::path& file) {
   constexpr std::size_t kMaxHeader = 1 << 16;
+  const std::string name = file.string();
   std::ifstream in(file, std::ios::binary);
   std::string head(kMaxHeader, '\0');
   in.read(head.data(), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
-  const std::size_t end = head.find("end_header");
-  if (head.rfind("ply", 0) != 0 || end == std::string::npos) return;
-  const std::size_t body_at = head.find('\n', end);
-  if (body_at == std::string::npos) return;
+  if (head.rfind("ply\n", 0) != 0 && head.rfind("ply\r", 0) != 0) return;
+  const std::size_t end = head.find("\nend_header");
+  const std::size_t body_at = end == std::string::npos ? end : head.find('\n', end + 1);
+  if (body_at == std::string::npos)
+    throw InputError(name, 0, "", "the PLY header has no end_header line in its first 64 kB");
   struct Element {
     std::string name;
     std::uint64_t count = 0, bytes = 0;
@@ -75,7 +77,7 @@ void check_ply_counts(const fs::path& file) {
   };
   std::vector<Element> elements;
   bool ascii = true;
-  std::istringstream lines(head.substr(0, end));
+  std::istringstream lines(head.substr(0, end + 1));
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
     std::istringstream words(line);
@@ -87,18 +89,22 @@ void check_ply_counts(const fs::path& file) {
     } else if (word == "element") {
       Element e;
       e.line = number;
-      if (!(words >> e.name >> e.count)) return;
+      if (!(words >> e.name >> e.count)) throw InputError(name, number, "element", "needs a name and a count");
       elements.push_back(e);
-    } else if (word == "property" && !elements.empty() && words >> type) {
-      if (type == "list" && !(words >> type)) return;  // the list's count type
-      elements.back().bytes += ply_property_bytes(ascii, type);
+    } else if (word == "property") {
+      std::string item;
+      if (!(words >> type) || (type == "list" && !(words >> type >> item)) || ply_type_bytes(type) == 0 ||
+          (!item.empty() && ply_type_bytes(item) == 0))
+        throw InputError(name, number, "property", "not a PLY property type: '" + line + "'");
+      if (elements.empty()) throw InputError(name, number, "property", "comes before any element");
+      elements.back().bytes += ascii ? 1 : ply_type_bytes(type);
     }
   }
   std::uint64_t left = fs::file_size(file) - (body_at + 1);
   for (const Element& e : elements) {
     if (e.bytes == 0) continue;
     if (e.count > left / e.bytes)
-      throw InputError(file.string(), e.line, "element " + e.name,
+      throw InputError(name, e.line, "element " + e.name,
                        "the header claims " + std::to_string(e.count) + " elements of at least " +
                            std::to_string(e.bytes) + " bytes each; the " + std::to_string(left) +
                            " bytes left after the header cannot hold them");
@@ -140,7 +146,7 @@ void put_vertices(std::ostream& out, const std::vector<Eigen::Vector3f>& points)
 sim::TriangleMesh load_mesh(const fs::path& file) {
   const std::string name = file.string();
   check_readable(file, "mesh");
-  check_ply_counts(file);
+  check_ply_header(file);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                                      aiProcess_PreTransformVertices |

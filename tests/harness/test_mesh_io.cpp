@@ -139,3 +139,17 @@ TEST_CASE("a PLY whose header claims more elements than its bytes can hold is re
       input_error_of([&] { harness::load_mesh(dir.write("cut.ply", binary + std::string(35, '\0'))); });
   CHECK(cut.find("the 35 bytes left after the header cannot hold them") != std::string::npos);
 }
+
+// Assimp crashed on a binary PLY whose header never ended (fuzz/fuzz_mesh).
+TEST_CASE("a PLY header without its end_header line, or with a property of no PLY type, is refused",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const std::string element = "ply\nformat binary_little_endian 1.0\nelement vertex 1\n";
+  const std::string unended =
+      input_error_of([&] { harness::load_mesh(dir.write("unended.ply", element + "property double x\nend_head" +
+                                                                              std::string(12, '\0'))); });
+  CHECK(unended.find("unended.ply: the PLY header has no end_header line") != std::string::npos);
+  const std::string untyped = input_error_of(
+      [&] { harness::load_mesh(dir.write("untyped.ply", element + "property perty double x\nend_header\n")); });
+  CHECK(untyped.find("untyped.ply:4: key 'property': not a PLY property type") != std::string::npos);
+}
