@@ -3,6 +3,8 @@
 
 #include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
+#include "harness/support/interrupt.hpp"
+#include "harness/support/subprocess.hpp"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -112,6 +114,30 @@ void check_ply_header(const fs::path& file) {
   }
 }
 
+constexpr unsigned kMeshSteps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure;
+
+// Assimp aborts on some corrupt files (an assertion in its triangulation, on a PLY whose vertex
+// lacked z: fuzz/fuzz_mesh) and may crash or loop on others. The file is first read in a child
+// process, so that a crash or a hang there becomes a clear error here; a file assimp refuses
+// cleanly is refused again in this process, with its message.
+void screen_in_child(const fs::path& file) {
+  constexpr double kTimeoutS = 30.0;
+  bool timed_out = false;
+  const int status = run_isolated(
+      [&] {
+        Assimp::Importer importer;
+        importer.ReadFile(file.string(), kMeshSteps);
+        return 0;
+      },
+      kTimeoutS, timed_out);
+  throw_if_interrupted();
+  if (timed_out) throw InputError(file.string(), 0, "", "the mesh reader (assimp) did not finish within 30 s");
+  if (status != 0)
+    throw InputError(file.string(), 0, "",
+                     "the mesh reader (assimp) crashed on it (a corrupt file; exit status " + std::to_string(status) + ")");
+}
+
 // A binary little-endian PLY file: the header, then each element's records as written by
 // `body` (a few lines of plumbing rather than loading a PLY library for it).
 template <typename Body>
@@ -147,10 +173,9 @@ sim::TriangleMesh load_mesh(const fs::path& file) {
   const std::string name = file.string();
   check_readable(file, "mesh");
   check_ply_header(file);
+  screen_in_child(file);
   Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                                     aiProcess_PreTransformVertices |
-                                                     aiProcess_ValidateDataStructure);
+  const aiScene* scene = importer.ReadFile(name, kMeshSteps);
   if (!scene)
     throw InputError(name, 0, "", std::string("cannot read the mesh (") + importer.GetErrorString() + ")");
   sim::TriangleMesh mesh;
