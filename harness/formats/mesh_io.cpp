@@ -16,8 +16,11 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -53,60 +56,73 @@ std::uint64_t ply_type_bytes(const std::string& type) {
   return size == kSizes.end() ? 0 : size->second;
 }
 
-// Assimp's PLY reader trusts the header: it sizes its arrays by the element counts before it
-// reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
-// gigabytes), and it crashed on a header without its end_header line (fuzz/fuzz_mesh). So a
-// file that starts like a PLY must have a header that ends within 64 kB, elements with a name
-// and a count, properties of PLY's types, and counts that fit in the bytes after the header
-// (each element at least one byte per property in ASCII, its properties' sizes in binary, a
-// list at least its count). Refused naming the line.
-void check_ply_header(const fs::path& file) {
-  constexpr std::size_t kMaxHeader = 1 << 16;
-  const std::string name = file.string();
-  std::ifstream in(file, std::ios::binary);
-  std::string head(kMaxHeader, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  if (head.rfind("ply\n", 0) != 0 && head.rfind("ply\r", 0) != 0) return;
-  const std::size_t end = head.find("\nend_header");
-  const std::size_t body_at = end == std::string::npos ? end : head.find('\n', end + 1);
-  if (body_at == std::string::npos)
-    throw InputError(name, 0, "", "the PLY header has no end_header line in its first 64 kB");
+// A PLY header as read for its checks: its elements (name, count, the fewest bytes one takes:
+// one per property in ASCII, the properties' sizes in binary, a list at least its count) and
+// the bytes after it.
+struct PlyHeader {
   struct Element {
     std::string name;
     std::uint64_t count = 0, bytes = 0;
     int line = 0;
   };
   std::vector<Element> elements;
+  std::uint64_t body_bytes = 0;
+};
+
+// Reads the header of a file that starts like a PLY (nullopt for other files). Throws
+// InputError naming the line for a header without end_header in its first 64 kB, an element
+// without a name and a count, or a property of a type PLY does not define.
+std::optional<PlyHeader> read_ply_header(const fs::path& file) {
+  constexpr std::size_t kMaxHeader = 1 << 16;
+  const std::string name = file.string();
+  std::ifstream in(file, std::ios::binary);
+  std::string head(kMaxHeader, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.rfind("ply\n", 0) != 0 && head.rfind("ply\r", 0) != 0) return std::nullopt;
+  const std::size_t end = head.find("\nend_header");
+  const std::size_t body_at = end == std::string::npos ? end : head.find('\n', end + 1);
+  if (body_at == std::string::npos)
+    throw InputError(name, 0, "", "the PLY header has no end_header line in its first 64 kB");
+  PlyHeader header;
+  header.body_bytes = fs::file_size(file) - (body_at + 1);
   bool ascii = true;
   std::istringstream lines(head.substr(0, end + 1));
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
     std::istringstream words(line);
-    std::string word, type;
+    std::string word, type, item;
     words >> word;
     if (word == "format") {
       words >> type;
       ascii = type == "ascii";
     } else if (word == "element") {
-      Element e;
+      PlyHeader::Element& e = header.elements.emplace_back();
       e.line = number;
       if (!(words >> e.name >> e.count)) throw InputError(name, number, "element", "needs a name and a count");
-      elements.push_back(e);
     } else if (word == "property") {
-      std::string item;
       if (!(words >> type) || (type == "list" && !(words >> type >> item)) || ply_type_bytes(type) == 0 ||
           (!item.empty() && ply_type_bytes(item) == 0))
         throw InputError(name, number, "property", "not a PLY property type: '" + line + "'");
-      if (elements.empty()) throw InputError(name, number, "property", "comes before any element");
-      elements.back().bytes += ascii ? 1 : ply_type_bytes(type);
+      if (header.elements.empty()) throw InputError(name, number, "property", "comes before any element");
+      header.elements.back().bytes += ascii ? 1 : ply_type_bytes(type);
     }
   }
-  std::uint64_t left = fs::file_size(file) - (body_at + 1);
-  for (const Element& e : elements) {
+  return header;
+}
+
+// Assimp's PLY reader trusts the header: it sizes its arrays by the element counts before it
+// reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
+// gigabytes), and it crashed on a header without its end_header line (fuzz/fuzz_mesh). So the
+// header must read (read_ply_header) and its counts fit in the bytes after it.
+void check_ply_header(const fs::path& file) {
+  const std::optional<PlyHeader> header = read_ply_header(file);
+  if (!header) return;
+  std::uint64_t left = header->body_bytes;
+  for (const PlyHeader::Element& e : header->elements) {
     if (e.bytes == 0) continue;
     if (e.count > left / e.bytes)
-      throw InputError(name, e.line, "element " + e.name,
+      throw InputError(file.string(), e.line, "element " + e.name,
                        "the header claims " + std::to_string(e.count) + " elements of at least " +
                            std::to_string(e.bytes) + " bytes each; the " + std::to_string(left) +
                            " bytes left after the header cannot hold them");
@@ -132,6 +148,7 @@ void screen_in_child(const fs::path& file) {
       },
       kTimeoutS, timed_out);
   throw_if_interrupted();
+  if (status == -1) throw std::runtime_error("cannot start a process to read " + file.string());
   if (timed_out) throw InputError(file.string(), 0, "", "the mesh reader (assimp) did not finish within 30 s");
   if (status != 0)
     throw InputError(file.string(), 0, "",
