@@ -28,24 +28,6 @@ namespace sonomap::harness {
 
 namespace {
 
-// Fails unless `file` is a regular file and, when named .ply, starts like one (rply prints its
-// own complaint about a bad header; say it ourselves instead).
-void check_readable(const fs::path& file, const std::string& what) {
-  const std::string name = file.string();
-  std::error_code ec;
-  if (!fs::exists(file, ec)) throw InputError(name, 0, "", what + " file does not exist");
-  if (!fs::is_regular_file(file, ec)) throw InputError(name, 0, "", what + " path is not a file");
-  std::string extension = file.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".ply") {
-    std::ifstream in(file, std::ios::binary);
-    char magic[4] = {};
-    in.read(magic, 4);
-    if (std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
-      throw InputError(name, 1, "", "not a PLY file (it does not start with 'ply')");
-  }
-}
-
 // The bytes of a PLY scalar type; 0 for a type PLY does not define.
 std::uint64_t ply_type_bytes(const std::string& type) {
   static const std::map<std::string, std::uint64_t> kSizes = {
@@ -111,8 +93,8 @@ std::optional<PlyHeader> read_ply_header(const fs::path& file) {
   return header;
 }
 
-// Assimp's PLY reader trusts the header: it sizes its arrays by the element counts before it
-// reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
+// Assimp's PLY reader trusts the header (as Open3D's reader of point clouds does): it sizes
+// its arrays by the element counts before it reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
 // gigabytes), and it crashed on a header without its end_header line (fuzz/fuzz_mesh). So the
 // header must read (read_ply_header) and its counts fit in the bytes after it.
 void check_ply_header(const fs::path& file) {
@@ -128,6 +110,26 @@ void check_ply_header(const fs::path& file) {
                            " bytes left after the header cannot hold them");
     left -= e.count * e.bytes;
   }
+}
+
+// Fails unless `file` is a regular file and, when named .ply, starts like one (Open3D's rply
+// prints its own complaint about a bad header; say it ourselves instead), and unless a PLY
+// header reads and its counts fit (check_ply_header): both readers trust them.
+void check_readable(const fs::path& file, const std::string& what) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(name, 0, "", what + " file does not exist");
+  if (!fs::is_regular_file(file, ec)) throw InputError(name, 0, "", what + " path is not a file");
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".ply") {
+    std::ifstream in(file, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, 4);
+    if (std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
+      throw InputError(name, 1, "", "not a PLY file (it does not start with 'ply')");
+  }
+  check_ply_header(file);
 }
 
 constexpr unsigned kMeshSteps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
@@ -189,7 +191,6 @@ void put_vertices(std::ostream& out, const std::vector<Eigen::Vector3f>& points)
 sim::TriangleMesh load_mesh(const fs::path& file) {
   const std::string name = file.string();
   check_readable(file, "mesh");
-  check_ply_header(file);
   screen_in_child(file);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(name, kMeshSteps);

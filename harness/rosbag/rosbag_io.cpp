@@ -51,13 +51,14 @@ struct MessageKind<geometry_msgs::PoseStamped>
 // checks of the chunk's records before rosbag reads them (check_bag_records).
 bool inflate_chunk(const std::string& compression, const std::string& packed, std::string& out) {
   if (packed.size() > std::numeric_limits<unsigned int>::max()) return false;
-  std::string in = packed;  // both libraries take a non-const input
+  // Both libraries take the input as char* but only read it: no copy of the chunk for them.
+  char* in = const_cast<char*>(packed.data());
   unsigned int size = static_cast<unsigned int>(out.size());
-  const auto in_size = static_cast<unsigned int>(in.size());
+  const auto in_size = static_cast<unsigned int>(packed.size());
   if (compression == "lz4")
-    return roslz4_buffToBuffDecompress(in.data(), in_size, out.data(), &size) == ROSLZ4_OK && size == out.size();
+    return roslz4_buffToBuffDecompress(in, in_size, out.data(), &size) == ROSLZ4_OK && size == out.size();
   if (compression == "bz2")
-    return BZ2_bzBuffToBuffDecompress(out.data(), &size, in.data(), in_size, 0, 0) == BZ_OK && size == out.size();
+    return BZ2_bzBuffToBuffDecompress(out.data(), &size, in, in_size, 0, 0) == BZ_OK && size == out.size();
   return false;
 }
 

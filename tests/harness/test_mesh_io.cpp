@@ -169,3 +169,14 @@ TEST_CASE("a mesh file on which assimp crashes is refused naming the file, and t
   CHECK(message.find("no_z.ply") != std::string::npos);
   CHECK(message.find("the mesh reader (assimp) crashed on it") != std::string::npos);
 }
+
+// Open3D's reader of point clouds sizes its points by the header's count too.
+TEST_CASE("a point cloud PLY whose header claims more vertices than its bytes can hold is refused naming the line",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const std::string message = input_error_of([&] {
+    harness::load_point_cloud(dir.write("cloud.ply", "ply\nformat ascii 1.0\nelement vertex 100000000\nproperty float x\n"
+                                                     "property float y\nproperty float z\nend_header\n0 0 0\n"));
+  });
+  CHECK(message.find("cloud.ply:3: key 'element vertex'") != std::string::npos);
+}
