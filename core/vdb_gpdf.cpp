@@ -42,7 +42,13 @@ constexpr double kEdgePixels = 3.0;
 constexpr double kVacatedVoxels = 1.0;
 // A voxel the map holds as free that this frame puts inside an object, more than this many
 // voxels behind the surface its pixel measured, has been entered: an object arrived.
+// That surface must also be new to the map: its measured point more than this many voxels in
+// front of any surface the map holds (else the voxel may lie behind a panel thinner than the
+// behind votes' reach, in free space the map saw: in the random box rooms of docs/fidelity.md
+// surfaces then ran up to a voxel past thin panels' hidden sides). Half a voxel is the depth
+// noise's room: at 0.4 voxel or less the panels' bulges came back.
 constexpr double kArrivedVoxels = 1.0;
+constexpr double kNewSurfaceVoxels = 0.5;
 // The most an inside ("behind") vote adds to a voxel's value, in voxels. Behind votes land up
 // to two query steps behind the surface, and the GPs' distance there (to the visible face)
 // says nothing of how thin the object is: a panel may end a centimetre behind its face. Next
@@ -75,7 +81,7 @@ struct QueryUpdate {
   float distance;
   float weight;
   bool hit = false;  // from a surface point or behind it (not from free space in front)
-  bool seen_inside = false;  // inside by its votes, and its pixel saw a surface well in front
+  bool seen_inside = false;  // inside by its votes, and an object arrived there (arrival_seen)
 };
 
 // The frame's depth image seen from the world: whether a point lies in front of (or behind)
@@ -135,6 +141,17 @@ class DepthView {
     if (!s.pixel) return false;
     const float d = depth_at(s.pixel->u, s.pixel->v);
     return d > 0.0f && d < s.camera.z() - margin;
+  }
+
+  // The world point that the point's pixel measured (none outside the image or where the
+  // pixel measured nothing).
+  std::optional<Eigen::Vector3d> measured(const Sight& s) const {
+    if (!s.pixel) return std::nullopt;
+    const double d = depth_at(s.pixel->u, s.pixel->v);
+    if (!(d > 0.0)) return std::nullopt;
+    const PinholeIntrinsics& k = frame_.intrinsics;
+    const Eigen::Vector3d camera((s.pixel->u - k.cx) / k.fx * d, (s.pixel->v - k.cy) / k.fy * d, d);
+    return frame_.world_T_camera * camera;
   }
 
  private:
@@ -751,6 +768,43 @@ void vote_beside_surfaces(const DepthView& view, const openvdb::MaskGrid& near, 
     if (!acc.isValueOn(v.getCoord())) acc.setValue(v.getCoord(), free_vote);
 }
 
+// What a voxel's update reads besides its votes: the frame's local GPs, its voxels near the
+// points, its depth image and the map as it was before the frame (one per task: accessors).
+struct UpdateLookups {
+  const LocalGps& locals;
+  openvdb::MaskGrid::ConstAccessor near;
+  const DepthView& view;
+  DistanceWeightGrid::ConstAccessor map;
+};
+
+// Whether the surface that `sight`'s pixel measured is new to the map: the map's value at the
+// measured point (trilinear between the 8 voxel centres around it) says free space more than
+// kNewSurfaceVoxels in front of any surface it holds, or the map has not observed all 8.
+bool measured_surface_is_new(const VdbGpdfConfig& config, const UpdateLookups& at, const DepthView::Sight& sight) {
+  const std::optional<Eigen::Vector3d> measured = at.view.measured(sight);
+  if (!measured) return false;
+  const Eigen::Vector3d g = *measured / config.global_voxel - Eigen::Vector3d::Constant(0.5);
+  const Eigen::Vector3d base = g.array().floor();
+  const Eigen::Vector3d t = g - base;
+  const openvdb::Coord b(static_cast<int>(base.x()), static_cast<int>(base.y()), static_cast<int>(base.z()));
+  double value = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+    const openvdb::Vec2s old = at.map.getValue(b.offsetBy(dx, dy, dz));
+    if (!(old[1] > 0.0f)) return true;
+    value += (dx ? t.x() : 1 - t.x()) * (dy ? t.y() : 1 - t.y()) * (dz ? t.z() : 1 - t.z()) * old[0];
+  }
+  return value < -kNewSurfaceVoxels * config.global_voxel;
+}
+
+// Whether an object has arrived at the voxel seen along `sight`: its pixel measured a surface
+// more than kArrivedVoxels in front of the centre, and that surface is new to the map. A
+// voxel behind a panel thinner than the behind votes' reach (two query steps) is also "behind
+// the measured surface"; but the panel is one the map holds already.
+bool arrival_seen(const VdbGpdfConfig& config, const UpdateLookups& at, const DepthView::Sight& sight) {
+  return at.view.seen_behind(sight, kArrivedVoxels * config.global_voxel) && measured_surface_is_new(config, at, sight);
+}
+
 // One voxel's update from its votes and the local GPs' distance d at its centre: each kept
 // vote adds +-d with one unit of weight. Near the surface a free-space value needs the depth
 // image's word for it (DepthView): a centre the camera saw behind the surface keeps no
@@ -758,8 +812,8 @@ void vote_beside_surfaces(const DepthView& view, const openvdb::MaskGrid& near, 
 // free vote near the surface needs the centre's pixel and its 8 neighbours to have measured
 // something farther (a front point or ray beside a grazing face passes a centre inside it).
 bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
-                  openvdb::Vec4f surface, const LocalGps& locals,
-                  const openvdb::MaskGrid::ConstAccessor& near, const DepthView& view, QueryUpdate& out) {
+                  openvdb::Vec4f surface, const UpdateLookups& at, QueryUpdate& out) {
+  const DepthView& view = at.view;
   const Eigen::Vector3d centre = voxel_centre(voxel, config.global_voxel);
   const DepthView::Sight sight = view.sight(centre);  // projected once for every check below
   std::optional<bool> in_front;  // view.seen_in_front(sight) (9 pixels), asked at most once
@@ -769,11 +823,24 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   };
   const bool behind = view.seen_behind(sight, kBehindMargin * config.global_voxel);
   if (surface[3] > 0 && behind) surface[2] = surface[3] = 0.0f;
-  if (votes[kFree] > 0 && near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
+  if (votes[kFree] > 0 && at.near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
   // free votes of vote_beside_surfaces they made the surface bulge past the silhouette).
   if (votes[kHitInside] > 0 && view.has_image() && seen_in_front()) votes[kHitInside] = 0;
+  // Nor does a behind vote overturn space the map holds as free, unless an object arrived
+  // there: the free space was seen, while a behind vote only guesses the object's depth. Seen
+  // from its far side, a panel thinner than the votes' reach let them into the space seen
+  // free in front of it, and its near side moved up to 9 cm toward its viewer.
+  std::optional<bool> arrived;  // arrival_seen(config, at, sight), asked at most once
+  auto arrival = [&] {
+    if (!arrived) arrived = arrival_seen(config, at, sight);
+    return *arrived;
+  };
+  if (votes[kHitInside] > 0) {
+    const openvdb::Vec2s old = at.map.getValue(voxel);
+    if (old[1] > 0.0f && old[0] < 0.0f && !arrival()) votes[kHitInside] = 0;
+  }
   // A front point's centre behind the tangent plane: free if the camera saw through it, inside
   // if its pixel saw the surface nearer, else unknown (beside a silhouette, where a curved or
   // grazing surface's plane is no guide: a column's edge grew 8 cm into free space).
@@ -794,7 +861,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // (or for the variance that inverse-variance fusion weights by).
   double distance = 0.0, variance = config.variance_on_surface;
   if (inside + free > 0 || config.inverse_variance_fusion) {
-    const GpPrediction pred = locals.smallest(centre, config.inverse_variance_fusion);
+    const GpPrediction pred = at.locals.smallest(centre, config.inverse_variance_fusion);
     if (!pred.valid) return false;
     distance = pred.distance;
     variance = pred.variance;
@@ -806,7 +873,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   out = {voxel, static_cast<float>(sum / weight),
          static_cast<float>(config.inverse_variance_fusion ? weight / variance : weight),
          votes[kHitInside] + surface_votes > 0};
-  out.seen_inside = out.hit && out.distance > 0.0f && view.seen_behind(sight, kArrivedVoxels * config.global_voxel);
+  out.seen_inside = out.hit && out.distance > 0.0f && arrival();
   return true;
 }
 
@@ -831,11 +898,11 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
   parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
-    const auto near = local.near.getConstAccessor();
+    const UpdateLookups lookups{local.gps, local.near.getConstAccessor(), view, fused.getConstAccessor()};
     const auto surface_acc = surface.getConstAccessor();
     QueryUpdate update;
     for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v)
-      if (voxel_update(config, v.getCoord(), *v, surface_acc.getValue(v.getCoord()), local.gps, near, view, update))
+      if (voxel_update(config, v.getCoord(), *v, surface_acc.getValue(v.getCoord()), lookups, update))
         per_leaf[i].push_back(update);
   });
   std::vector<QueryUpdate> updates;
