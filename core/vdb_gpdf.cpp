@@ -831,13 +831,15 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // Nor does a behind vote overturn space the map holds as free, unless an object arrived
   // there: the free space was seen, while a behind vote only guesses the object's depth. Seen
   // from its far side, a panel thinner than the votes' reach let them into the space seen
-  // free in front of it, and its near side moved up to 9 cm toward its viewer.
+  // free in front of it, and its near side moved up to 9 cm toward its viewer. (Without a
+  // depth image no arrival can be seen, and dropping them would keep an object that steps
+  // into free space out of the map for good.)
   std::optional<bool> arrived;  // arrival_seen(config, at, sight), asked at most once
   auto arrival = [&] {
     if (!arrived) arrived = arrival_seen(config, at, sight);
     return *arrived;
   };
-  if (votes[kHitInside] > 0) {
+  if (votes[kHitInside] > 0 && view.has_image()) {
     const openvdb::Vec2s old = at.map.getValue(voxel);
     if (old[1] > 0.0f && old[0] < 0.0f && !arrival()) votes[kHitInside] = 0;
   }
