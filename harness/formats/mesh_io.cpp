@@ -45,15 +45,55 @@ struct PlyHeader {
   struct Element {
     std::string name;
     std::uint64_t count = 0, bytes = 0;
-    int line = 0;
+    int line = 0, properties = 0;
   };
   std::vector<Element> elements;
   std::uint64_t body_bytes = 0;
 };
 
+// Fails unless the last element read so far has a property: an element needs some to be read.
+void check_last_element(const std::string& file, const PlyHeader& header) {
+  if (!header.elements.empty() && header.elements.back().properties == 0)
+    throw InputError(file, header.elements.back().line, "element", "has no properties");
+}
+
+// Reads header line `number` (after "ply") into `header`; `ascii` follows the format line.
+void read_ply_header_line(const std::string& file, const std::string& line, int number, bool& ascii,
+                          PlyHeader& header) {
+  std::istringstream words(line);
+  std::string word, type, item, property, extra;
+  words >> word;
+  auto refuse = [&](const std::string& key, const std::string& what) {
+    throw InputError(file, number, key, what + ": '" + printable(line) + "'");
+  };
+  if (word == "comment" || word == "obj_info") return;
+  if (word == "format") {
+    words >> type;
+    ascii = type == "ascii";
+  } else if (word == "element") {
+    check_last_element(file, header);
+    PlyHeader::Element& e = header.elements.emplace_back();
+    e.line = number;
+    if (!(words >> e.name >> e.count) || words >> extra) refuse("element", "needs a name and a count, and nothing else");
+  } else if (word == "property") {
+    if (!(words >> type) || (type == "list" && !(words >> type >> item)) || ply_type_bytes(type) == 0 ||
+        (!item.empty() && ply_type_bytes(item) == 0))
+      refuse("property", "not a PLY property type");
+    if (!(words >> property) || words >> extra) refuse("property", "needs a type and a name, and nothing else");
+    if (header.elements.empty()) refuse("property", "comes before any element");
+    header.elements.back().bytes += ascii ? 1 : ply_type_bytes(type);
+    ++header.elements.back().properties;
+  } else {
+    refuse("", "not a PLY header line");
+  }
+}
+
 // Reads the header of a file that starts like a PLY (nullopt for other files). Throws
-// InputError naming the line for a header without end_header in its first 64 kB, an element
-// without a name and a count, or a property of a type PLY does not define.
+// InputError naming the line for a header without end_header in its first 64 kB, a line that
+// is no PLY header line (format, comment, obj_info, element, property), an element without
+// exactly a name and a count or without properties, or a property of a type PLY does not define.
+// (Assimp read on through such lines: on a fuzzed header with an element line ending in a NUL
+// and junk lines after it, it did not finish within 30 s.)
 std::optional<PlyHeader> read_ply_header(const fs::path& file) {
   constexpr std::size_t kMaxHeader = 1 << 16;
   const std::string name = file.string();
@@ -71,25 +111,9 @@ std::optional<PlyHeader> read_ply_header(const fs::path& file) {
   bool ascii = true;
   std::istringstream lines(head.substr(0, end + 1));
   std::string line;
-  for (int number = 1; std::getline(lines, line); ++number) {
-    std::istringstream words(line);
-    std::string word, type, item;
-    words >> word;
-    if (word == "format") {
-      words >> type;
-      ascii = type == "ascii";
-    } else if (word == "element") {
-      PlyHeader::Element& e = header.elements.emplace_back();
-      e.line = number;
-      if (!(words >> e.name >> e.count)) throw InputError(name, number, "element", "needs a name and a count");
-    } else if (word == "property") {
-      if (!(words >> type) || (type == "list" && !(words >> type >> item)) || ply_type_bytes(type) == 0 ||
-          (!item.empty() && ply_type_bytes(item) == 0))
-        throw InputError(name, number, "property", "not a PLY property type: '" + line + "'");
-      if (header.elements.empty()) throw InputError(name, number, "property", "comes before any element");
-      header.elements.back().bytes += ascii ? 1 : ply_type_bytes(type);
-    }
-  }
+  std::getline(lines, line);  // "ply"
+  for (int number = 2; std::getline(lines, line); ++number) read_ply_header_line(name, line, number, ascii, header);
+  check_last_element(name, header);
   return header;
 }
 

@@ -3,6 +3,7 @@
 // The CLI maps it to exit status 2.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +15,10 @@ class InputError : public std::runtime_error {
   InputError(const std::string& file, int line, const std::string& key, const std::string& what);
   explicit InputError(const std::string& what) : std::runtime_error(what) {}
 };
+
+// Text from a user's file as an error message can show it: bytes outside printable ASCII as
+// \xHH, at most `limit` characters of it (then "...").
+std::string printable(const std::string& text, std::size_t limit = 80);
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitFailure = 1;

@@ -154,6 +154,37 @@ TEST_CASE("a PLY header without its end_header line, or with a property of no PL
   CHECK(untyped.find("untyped.ply:4: key 'property': not a PLY property type") != std::string::npos);
 }
 
+// Assimp did not finish within 30 s on a fuzzed header whose element line ended in a NUL and
+// junk, followed by junk lines (fuzz/fuzz_mesh): a header reads as PLY's keywords or is refused.
+TEST_CASE("a PLY header line that is no PLY keyword, or an element line with more than a name and a count, "
+          "is refused naming the line",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const std::string format = "ply\nformat ascii 1.0\n";
+  const std::string triangle = "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+                               "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string nul = input_error_of([&] {
+    harness::load_mesh(dir.write("nul.ply", format + "element vertex 3" + std::string(1, '\0') + "ply\n" + triangle));
+  });
+  CHECK(nul.find("nul.ply:3: key 'element': needs a name and a count, and nothing else: 'element vertex 3\\x00ply'") !=
+        std::string::npos);
+  const std::string junk = input_error_of(
+      [&] { harness::load_mesh(dir.write("junk.ply", format + "element vertex 3\nform0.0800\n" + triangle)); });
+  CHECK(junk.find("junk.ply:4: not a PLY header line: 'form0.0800'") != std::string::npos);
+  const std::string empty = input_error_of([&] {
+    harness::load_mesh(dir.write("empty.ply", format + "element vertex 3\n" + triangle.substr(triangle.find("element face"))));
+  });
+  CHECK(empty.find("empty.ply:3: key 'element': has no properties") != std::string::npos);
+  // The same triangle with comment and obj_info lines, and CR LF line ends, loads.
+  std::string crlf;
+  for (char c : format + "comment a triangle\nobj_info made by hand\nelement vertex 3\n" + triangle) {
+    if (c == '\n') crlf += '\r';
+    crlf += c;
+  }
+  const sim::TriangleMesh mesh = harness::load_mesh(dir.write("good.ply", crlf));
+  CHECK(mesh.triangles.size() == 1);
+}
+
 // Assimp aborted (an assertion in its triangulation) on a binary PLY whose header lost its
 // vertices' z (fuzz/fuzz_mesh): the faces are then read from the vertices' bytes. The reader
 // runs assimp in a child process first, so the crash is an error naming the file.
