@@ -7,6 +7,7 @@
 #include <csignal>
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -113,9 +114,13 @@ extern "C" void __sanitizer_set_death_callback(void (*callback)()) __attribute__
 
 int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed_out) {
   timed_out = false;
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) return -1;
   if (pid == 0) {  // the child: no destructors, atexit handlers or stdio flushes of the parent's
+    // It dies with the program: a parent killed outright (SIGKILL, or libFuzzer ending on a
+    // timeout) left a child looping in assimp behind, for an hour, until killed by hand.
+    if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(127);
     // A crash ends the child as a crash, whatever handler the process had installed (a
     // sanitizer's or libFuzzer's report would claim the parent's crash: fuzz/fuzz_mesh).
     for (const int fatal : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) std::signal(fatal, SIG_DFL);

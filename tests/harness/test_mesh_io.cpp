@@ -2,6 +2,7 @@
 // The map's PLY files as another program reads them (Open3D's reader, which shares no code with
 // sonomap's writer), and Open3D, ROS and netCDF loaded only by the runs that use them.
 #include "harness/formats/mesh_io.hpp"
+#include "harness/support/subprocess.hpp"
 #include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
@@ -11,7 +12,13 @@
 #include <open3d/io/PointCloudIO.h>
 #include <open3d/io/TriangleMeshIO.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
+#include <fstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -210,4 +217,47 @@ TEST_CASE("a point cloud PLY whose header claims more vertices than its bytes ca
                                                      "property float y\nproperty float z\nend_header\n0 0 0\n"));
   });
   CHECK(message.find("cloud.ply:3: key 'element vertex'") != std::string::npos);
+}
+
+namespace {
+// Whether process `pid` is gone (or a zombie waiting for its new parent to reap it).
+bool process_gone(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string pid_field, name, state;
+  return !(stat >> pid_field >> name >> state) || state == "Z";
+}
+}  // namespace
+
+// The screening child of a mesh or SOFA file (run_isolated) must not outlive the program: a
+// parent killed outright, as libFuzzer ends on a timeout, left a child looping in assimp.
+TEST_CASE("a screening child dies with the program that started it", "[mesh_io]") {
+  int pipe_fds[2];
+  REQUIRE(::pipe(pipe_fds) == 0);
+  const pid_t program = ::fork();
+  REQUIRE(program >= 0);
+  if (program == 0) {  // the program: screens "a file" whose reader never returns
+    bool timed_out = false;
+    harness::run_isolated(
+        [&] {
+          const pid_t self = ::getpid();
+          if (::write(pipe_fds[1], &self, sizeof self) != sizeof self) return 1;
+          for (;;) ::pause();
+        },
+        600.0, timed_out);
+    ::_exit(0);
+  }
+  pid_t child = 0;
+  REQUIRE(::read(pipe_fds[0], &child, sizeof child) == sizeof child);
+  ::close(pipe_fds[0]);
+  ::close(pipe_fds[1]);
+  CHECK_FALSE(process_gone(child));
+  ::kill(program, SIGKILL);
+  ::waitpid(program, nullptr, 0);
+  bool gone = false;
+  for (int i = 0; i < 500 && !gone; ++i) {
+    gone = process_gone(child);
+    if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!gone) ::kill(child, SIGKILL);  // not left behind by the test either
+  CHECK(gone);
 }
