@@ -118,17 +118,16 @@ std::optional<PlyHeader> read_ply_header(const fs::path& file) {
 }
 
 // Assimp's PLY reader trusts the header (as Open3D's reader of point clouds does): it sizes
-// its arrays by the element counts before it reads the elements (a 2 kB file claiming 100 million vertices kept it busy for minutes and
-// gigabytes), and it crashed on a header without its end_header line (fuzz/fuzz_mesh). So the
-// header must read (read_ply_header) and its counts fit in the bytes after it.
-void check_ply_header(const fs::path& file) {
-  const std::optional<PlyHeader> header = read_ply_header(file);
-  if (!header) return;
-  std::uint64_t left = header->body_bytes;
-  for (const PlyHeader::Element& e : header->elements) {
+// its arrays by the element counts before it reads the elements (a 2 kB file claiming 100
+// million vertices kept it busy for minutes and gigabytes), and it crashed on a header without
+// its end_header line (fuzz/fuzz_mesh). So the header must read (read_ply_header) and its
+// counts fit in the bytes after it.
+void check_ply_counts(const std::string& file, const PlyHeader& header) {
+  std::uint64_t left = header.body_bytes;
+  for (const PlyHeader::Element& e : header.elements) {
     if (e.bytes == 0) continue;
     if (e.count > left / e.bytes)
-      throw InputError(file.string(), e.line, "element " + e.name,
+      throw InputError(file, e.line, "element " + e.name,
                        "the header claims " + std::to_string(e.count) + " elements of at least " +
                            std::to_string(e.bytes) + " bytes each; the " + std::to_string(left) +
                            " bytes left after the header cannot hold them");
@@ -138,7 +137,7 @@ void check_ply_header(const fs::path& file) {
 
 // Fails unless `file` is a regular file and, when named .ply, starts like one (Open3D's rply
 // prints its own complaint about a bad header; say it ourselves instead), and unless a PLY
-// header reads and its counts fit (check_ply_header): both readers trust them.
+// header (any file that starts like one) reads and its counts fit: both readers trust them.
 void check_readable(const fs::path& file, const std::string& what) {
   const std::string name = file.string();
   std::error_code ec;
@@ -146,14 +145,9 @@ void check_readable(const fs::path& file, const std::string& what) {
   if (!fs::is_regular_file(file, ec)) throw InputError(name, 0, "", what + " path is not a file");
   std::string extension = file.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".ply") {
-    std::ifstream in(file, std::ios::binary);
-    char magic[4] = {};
-    in.read(magic, 4);
-    if (std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
-      throw InputError(name, 1, "", "not a PLY file (it does not start with 'ply')");
-  }
-  check_ply_header(file);
+  const std::optional<PlyHeader> header = read_ply_header(file);
+  if (header) check_ply_counts(name, *header);
+  else if (extension == ".ply") throw InputError(name, 1, "", "not a PLY file (it does not start with 'ply')");
 }
 
 constexpr unsigned kMeshSteps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
