@@ -3,7 +3,6 @@
 
 #include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
-#include "harness/support/interrupt.hpp"
 #include "harness/support/subprocess.hpp"
 
 #include <assimp/Importer.hpp>
@@ -158,21 +157,11 @@ constexpr unsigned kMeshSteps = aiProcess_Triangulate | aiProcess_JoinIdenticalV
 // process, so that a crash or a hang there becomes a clear error here; a file assimp refuses
 // cleanly is refused again in this process, with its message.
 void screen_in_child(const fs::path& file) {
-  constexpr double kTimeoutS = 30.0;
-  bool timed_out = false;
-  const int status = run_isolated(
-      [&] {
-        Assimp::Importer importer;
-        importer.ReadFile(file.string(), kMeshSteps);
-        return 0;
-      },
-      kTimeoutS, timed_out);
-  throw_if_interrupted();
-  if (status == -1) throw std::runtime_error("cannot start a process to read " + file.string());
-  if (timed_out) throw InputError(file.string(), 0, "", "the mesh reader (assimp) did not finish within 30 s");
-  if (status != 0)
-    throw InputError(file.string(), 0, "",
-                     "the mesh reader (assimp) crashed on it (a corrupt file; exit status " + std::to_string(status) + ")");
+  screen_file(file, "the mesh reader (assimp)", [&] {
+    Assimp::Importer importer;
+    importer.ReadFile(file.string(), kMeshSteps);
+    return 0;
+  });
 }
 
 // A binary little-endian PLY file: the header, then each element's records as written by

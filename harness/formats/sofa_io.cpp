@@ -4,7 +4,6 @@
 #include "audio/resample.hpp"
 #include "harness/formats/modules.hpp"
 #include "harness/support/errors.hpp"
-#include "harness/support/interrupt.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/subprocess.hpp"
 
@@ -91,28 +90,18 @@ Eigen::Matrix3d head_frame(const MYSOFA_HRTF& h) {
 // before libmysofa reads it: libmysofa 1.3.1 can loop for minutes on a corrupt HDF5 file that
 // netCDF's HDF5 reader refuses at once (found by fuzz/fuzz_sofa). Returns whether both open it.
 bool screen_in_child(const fs::path& file) {
-  constexpr double kTimeoutS = 30.0;
   constexpr int kOpens = 0, kRefused = 10, kNoNetcdf = 11;
-  bool timed_out = false;
-  const int status = run_isolated(
-      [&] {
-        try {
-          if (netcdf_functions().open_status(file) != 0) return kRefused;
-        } catch (const std::runtime_error&) {
-          return kNoNetcdf;  // the parent loads it again and says why it cannot
-        }
-        int err = 0;
-        MYSOFA_HRTF* hrtf = mysofa_load(file.c_str(), &err);
-        if (hrtf) mysofa_free(hrtf);
-        return hrtf && err == MYSOFA_OK ? kOpens : kRefused;
-      },
-      kTimeoutS, timed_out);
-  throw_if_interrupted();
-  if (timed_out) bad(file, "the SOFA readers did not finish within 30 s (a corrupt file)");
-  if (status != kOpens && status != kRefused && status != kNoNetcdf)
-    bad(file, "the SOFA readers (HDF5, libmysofa) crashed on it (a corrupt file; exit status " +
-                  std::to_string(status) + ")");
-  return status == kOpens;
+  return screen_file(file, "the SOFA readers (HDF5, libmysofa)", [&] {
+           try {
+             if (netcdf_functions().open_status(file) != 0) return kRefused;
+           } catch (const std::runtime_error&) {
+             return kNoNetcdf;  // the parent loads it again and says why it cannot
+           }
+           int err = 0;
+           MYSOFA_HRTF* hrtf = mysofa_load(file.c_str(), &err);
+           if (hrtf) mysofa_free(hrtf);
+           return hrtf && err == MYSOFA_OK ? kOpens : kRefused;
+         }) == kOpens;
 }
 
 }  // namespace

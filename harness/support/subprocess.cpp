@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "harness/support/subprocess.hpp"
 
+#include "harness/support/errors.hpp"
 #include "harness/support/interrupt.hpp"
 
 #include <chrono>
@@ -133,6 +134,20 @@ int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed
     ::_exit(code);
   }
   return wait_with_deadline(pid, pid, timeout_s, timed_out);
+}
+
+int screen_file(const std::filesystem::path& file, const std::string& readers, const std::function<int()>& read) {
+  constexpr double kTimeoutS = 30.0;
+  constexpr int kFirstFailure = 100;  // read's own codes lie below; 127 and 128 + signal above
+  bool timed_out = false;
+  const int status = run_isolated(read, kTimeoutS, timed_out);
+  throw_if_interrupted();
+  if (status == -1) throw std::runtime_error("cannot start a process to read " + file.string());
+  if (timed_out) throw InputError(file.string(), 0, "", readers + " did not finish within 30 s (a corrupt file)");
+  if (status >= kFirstFailure)
+    throw InputError(file.string(), 0, "",
+                     readers + " crashed on it (a corrupt file; exit status " + std::to_string(status) + ")");
+  return status;
 }
 
 }  // namespace sonomap::harness

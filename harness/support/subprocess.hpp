@@ -2,6 +2,7 @@
 // Running helper programs (gnuplot) without a shell, so paths with spaces or quotes are safe.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <thread>
@@ -24,6 +25,13 @@ int run_program_with_timeout(const std::vector<std::string>& argv, double timeou
 // that may crash or loop on hostile input (HDF5 on a corrupt SOFA file): the crash stays in the
 // child. Past `timeout_s` or on Ctrl-C the child is killed; `timed_out` tells which.
 int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed_out);
+
+// Opens a user's file with `read` in a child process first (run_isolated), for libraries that
+// may crash or loop on a corrupt file (assimp, HDF5, libmysofa): `read` returns a code below
+// 100 for what it found, which is returned. A crash or a hang past 30 s stays in the child and
+// becomes an InputError naming the file and `readers` ("the mesh reader (assimp)"); a child
+// that cannot be made is std::runtime_error, an interrupt (Ctrl-C) as interrupt.hpp says.
+int screen_file(const std::filesystem::path& file, const std::string& readers, const std::function<int()>& read);
 
 // Whether `program` is an executable file in one of PATH's folders.
 bool program_in_path(const std::string& program);
