@@ -8,7 +8,9 @@
 #include <csignal>
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -153,6 +155,38 @@ int screen_file(const std::filesystem::path& file, const std::string& readers, c
 }  // namespace sonomap::harness
 
 namespace sonomap::harness {
+
+ChildOutput::ChildOutput() : fd_(::memfd_create("sonomap-child-output", MFD_CLOEXEC)) {
+  if (fd_ < 0) throw std::runtime_error(std::string("cannot make a memory file for a child process: ") + std::strerror(errno));
+}
+
+ChildOutput::~ChildOutput() { ::close(fd_); }
+
+bool ChildOutput::write(const void* data, std::size_t bytes) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    const ssize_t n = ::write(fd_, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+std::string ChildOutput::read() const {
+  struct stat info {};
+  if (::fstat(fd_, &info) != 0) throw std::runtime_error("cannot read a child process's output");
+  std::string bytes(static_cast<std::size_t>(info.st_size), '\0');
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::pread(fd_, bytes.data() + done, bytes.size() - done, static_cast<off_t>(done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw std::runtime_error("cannot read a child process's output");
+    done += static_cast<std::size_t>(n);
+  }
+  return bytes;
+}
 
 bool program_in_path(const std::string& program) {
   const char* path = std::getenv("PATH");

@@ -2,6 +2,7 @@
 // Running helper programs (gnuplot) without a shell, so paths with spaces or quotes are safe.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -32,6 +33,24 @@ int run_isolated(const std::function<int()>& work, double timeout_s, bool& timed
 // becomes an InputError naming the file and `readers` ("the mesh reader (assimp)"); a child
 // that cannot be made is std::runtime_error, an interrupt (Ctrl-C) as interrupt.hpp says.
 int screen_file(const std::filesystem::path& file, const std::string& readers, const std::function<int()>& read);
+
+// Bytes a run_isolated child hands to its parent: an anonymous memory file (memfd), made
+// before the fork, that the child writes and the parent reads once the child has ended. Nothing
+// on disk, and no pipe that fills while the parent only waits.
+class ChildOutput {
+ public:
+  ChildOutput();  // throws std::runtime_error when no memory file can be made
+  ~ChildOutput();
+  ChildOutput(const ChildOutput&) = delete;
+  ChildOutput& operator=(const ChildOutput&) = delete;
+  // In the child: appends the bytes; false when they could not all be written.
+  bool write(const void* data, std::size_t bytes);
+  // In the parent: everything the child wrote.
+  std::string read() const;
+
+ private:
+  int fd_ = -1;
+};
 
 // Whether `program` is an executable file in one of PATH's folders.
 bool program_in_path(const std::string& program);

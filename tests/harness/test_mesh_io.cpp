@@ -12,6 +12,8 @@
 #include <open3d/io/PointCloudIO.h>
 #include <open3d/io/TriangleMeshIO.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -260,4 +262,43 @@ TEST_CASE("a screening child dies with the program that started it", "[mesh_io]"
   }
   if (!gone) ::kill(child, SIGKILL);  // not left behind by the test either
   CHECK(gone);
+}
+
+// The file is read in a child process, which hands the mesh (or why the file is none) back to
+// the program: what arrives must be the file's triangles, by their corners, and its refusals.
+TEST_CASE("an OBJ of two objects, one a quad, loads as its three triangles; a vertex not finite or no triangle "
+          "is refused with that reason",
+          "[mesh_io]") {
+  ScratchDir dir("mesh-io");
+  const sim::TriangleMesh mesh = harness::load_mesh(dir.write(
+      "two.obj", "o A\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no B\nv 2 0 0.5\nv 3 0 0.5\nv 3 1.25 0.5\nv 2 1.25 0.5\nf 4 5 6 7\n"));
+  using Corners = std::array<std::array<float, 3>, 3>;
+  std::vector<Corners> read;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    REQUIRE(t.minCoeff() >= 0);
+    REQUIRE(t.maxCoeff() < static_cast<int>(mesh.vertices.size()));
+    Corners c;
+    for (int k = 0; k < 3; ++k) c[k] = {mesh.vertices[t[k]].x(), mesh.vertices[t[k]].y(), mesh.vertices[t[k]].z()};
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());  // the winding kept, the start fixed
+    read.push_back(c);
+  }
+  std::sort(read.begin(), read.end());
+  // The quad 4 5 6 7 splits along one of its diagonals; either keeps its corners and winding.
+  const Corners triangle{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  const std::vector<Corners> along_5_7 = {triangle, {{{2, 0, 0.5f}, {3, 0, 0.5f}, {2, 1.25f, 0.5f}}},
+                                          {{{2, 1.25f, 0.5f}, {3, 0, 0.5f}, {3, 1.25f, 0.5f}}}};
+  const std::vector<Corners> along_4_6 = {triangle, {{{2, 0, 0.5f}, {3, 0, 0.5f}, {3, 1.25f, 0.5f}}},
+                                          {{{2, 0, 0.5f}, {3, 1.25f, 0.5f}, {2, 1.25f, 0.5f}}}};
+  auto sorted = [](std::vector<Corners> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  CHECK((read == sorted(along_4_6) || read == sorted(along_5_7)));
+
+  const std::string nan = input_error_of([&] { harness::load_mesh(dir.write("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")); });
+  CHECK(nan.find("nan.obj") != std::string::npos);
+  CHECK(nan.find("vertex 0 is not finite") != std::string::npos);
+  const std::string lines = input_error_of([&] { harness::load_mesh(dir.write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n")); });
+  CHECK(lines.find("lines.obj") != std::string::npos);
+  CHECK(lines.find("the mesh has no triangles") != std::string::npos);
 }
