@@ -182,6 +182,7 @@ std::string mesh_of_scene(const aiScene& scene, sim::TriangleMesh& mesh) {
 // The child's answer: kMesh and the mesh (vertex and triangle counts, then their coordinates
 // and indices), or kRefused and why.
 constexpr int kMesh = 0, kRefused = 1, kWriteFailed = 2;
+constexpr size_t kMaxReason = 400;  // characters of a refusal shown
 
 template <typename T>
 bool write_all(ChildOutput& out, const std::vector<T>& items) {
@@ -260,7 +261,8 @@ sim::TriangleMesh load_mesh(const fs::path& file) {
   const int found = screen_file(file, "the mesh reader (assimp)", [&] { return read_in_child(file, out); });
   if (found == kWriteFailed) throw std::runtime_error("the mesh reader's child process could not hand over " + file.string());
   const std::string bytes = out.read();
-  if (found == kRefused) throw InputError(file.string(), 0, "", bytes);
+  // Assimp's reasons may quote the file's bytes: shown escaped, as a PLY header line is.
+  if (found == kRefused) throw InputError(file.string(), 0, "", printable(bytes, kMaxReason));
   return mesh_from_bytes(bytes);
 }
 
