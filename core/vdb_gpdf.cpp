@@ -84,36 +84,119 @@ struct QueryUpdate {
   bool seen_inside = false;  // inside by its votes, and an object arrived there (arrival_seen)
 };
 
-// The frame's depth image seen from the world: whether a point lies in front of (or behind)
-// what the camera measured along its line of sight. A ray proves free only the space it crosses, but a
-// query or carving value lands at a voxel centre up to 0.87 voxel away, which beside an edge
-// seen at a grazing angle can lie inside the object: then its negative value rounds the edge
-// off (random box rooms: bins clipping a box's vertical edge read the wall behind). Near the
-// surface a centre gets a free-space value only if its pixel and their 8 neighbours (mixed
-// pixels at silhouettes report the far side) all measured something farther. Frames without
-// a depth image (point clouds) skip the check; a frame whose image is not width x height
-// pixels is rejected (std::invalid_argument), not read as a point cloud.
+// A frame without a depth image (a point cloud) seen as one, so that DepthView's checks hold
+// for clouds too: the nearest point in each direction, on the six faces of a cube around the
+// camera, each face a 90-degree pinhole image of kCubeCells x kCubeCells cells (0.25 degree at
+// a face's centre, as fine as a depth camera's pixels, finer than a lidar's rings: a cell the
+// cloud leaves empty says nothing, where an image's empty pixel is a ray that met nothing).
+// Depths are along the face's axis, as a pinhole image's are along z. Before it, clouds skipped
+// every check: rays carved the random box rooms' edges off (docs/fidelity.md: 28 corner bins
+// read too far, the TSDF peer 6) and an object stepping into space the map held free took 36
+// frames to reach the map.
+class CubeRangeImage {
+ public:
+  static constexpr int kCubeCells = 360;
+
+  explicit CubeRangeImage(const std::vector<Eigen::Vector3f>& points) : depth_(6 * kCubeCells * kCubeCells, 0.0f) {
+    for (const Eigen::Vector3f& p : points) {
+      const std::optional<Cell> c = cell_of(p.cast<double>());
+      if (!c) continue;
+      float& d = depth_[c->index];
+      if (d == 0.0f || c->depth < d) d = static_cast<float>(c->depth);
+    }
+  }
+
+  // A camera-frame point's cell and its depth along the cell's face axis (none at the camera or
+  // for a non-finite point).
+  struct Cell {
+    int index;
+    double depth;
+  };
+  static std::optional<Cell> cell_of(const Eigen::Vector3d& c) {
+    if (!c.allFinite()) return std::nullopt;
+    int axis = 0;
+    c.cwiseAbs().maxCoeff(&axis);
+    const double depth = std::abs(c[axis]);
+    if (!(depth > 0.0)) return std::nullopt;
+    const int face = 2 * axis + (c[axis] < 0.0 ? 1 : 0);
+    const int u = cell_coordinate(c[(axis + 1) % 3] / depth), v = cell_coordinate(c[(axis + 2) % 3] / depth);
+    return Cell{(face * kCubeCells + v) * kCubeCells + u, depth};
+  }
+
+  // Whether the cell and the 8 around it on its face measured something, all of it farther
+  // than `depth`. (A cell a cloud left empty says nothing: no ray may have passed there.)
+  bool farther_around(int index, double depth) const {
+    bool measured = false;
+    const int u = index % kCubeCells, v = (index / kCubeCells) % kCubeCells;
+    const int face_start = index - v * kCubeCells - u;
+    for (int y = std::max(v - 1, 0); y <= std::min(v + 1, kCubeCells - 1); ++y)
+      for (int x = std::max(u - 1, 0); x <= std::min(u + 1, kCubeCells - 1); ++x) {
+        const float d = depth_[static_cast<size_t>(face_start + y * kCubeCells + x)];
+        if (d > 0.0f && d <= depth) return false;
+        measured = measured || d > 0.0f;
+      }
+    return measured;
+  }
+
+  // The nearest depth measured in the cell (0: none).
+  float depth(int index) const { return depth_[static_cast<size_t>(index)]; }
+
+  // The camera-frame point at `depth` along the centre of cell `index`.
+  static Eigen::Vector3d point(int index, double depth) {
+    const int u = index % kCubeCells, v = (index / kCubeCells) % kCubeCells, face = index / (kCubeCells * kCubeCells);
+    const int axis = face / 2;
+    Eigen::Vector3d c;
+    c[axis] = face % 2 ? -depth : depth;
+    c[(axis + 1) % 3] = ((u + 0.5) * 2.0 / kCubeCells - 1.0) * depth;
+    c[(axis + 2) % 3] = ((v + 0.5) * 2.0 / kCubeCells - 1.0) * depth;
+    return c;
+  }
+
+ private:
+  // [-1, 1] on the face to a cell column or row.
+  static int cell_coordinate(double t) {
+    return std::clamp(static_cast<int>(std::floor((t + 1.0) * 0.5 * kCubeCells)), 0, kCubeCells - 1);
+  }
+
+  std::vector<float> depth_;
+};
+
+// The frame's depth image (or its cloud's cube) seen from the world: whether a point lies in
+// front of (or behind) what the camera measured along its line of sight. A ray proves free only
+// the space it crosses, but a query or carving value lands at a voxel centre up to 0.87 voxel
+// away, which beside an edge seen at a grazing angle can lie inside the object: then its
+// negative value rounds the edge off (random box rooms: bins clipping a box's vertical edge
+// read the wall behind). Near the surface a centre gets a free-space value only if its pixel
+// and their 8 neighbours (mixed pixels at silhouettes report the far side) all measured
+// something farther. A frame whose image is not width x height pixels is rejected
+// (std::invalid_argument), not read as a point cloud.
 class DepthView {
  public:
   explicit DepthView(const Frame& frame)
       : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
-        usable_(has_depth_image(frame)) {}  // throws when the image is not width x height
+        image_(has_depth_image(frame)) {  // throws when the image is not width x height
+    if (!image_) cube_.emplace(frame.points_camera);
+  }
 
   // A world point as the camera sees it: its camera coordinates and its pixel (none outside
-  // the image, or without an image). One projection answers every question about the point.
+  // the image), or for a cloud its cell of the cube. One projection answers every question
+  // about the point.
   struct Sight {
     Eigen::Vector3d camera;
     std::optional<Pixel> pixel;
+    std::optional<CubeRangeImage::Cell> cell;
   };
   Sight sight(const Eigen::Vector3d& world) const {
-    Sight s{camera_T_world_ * world, std::nullopt};
-    if (usable_) s.pixel = pixel_of(frame_.intrinsics, frame_.width, frame_.height, s.camera);
+    Sight s{camera_T_world_ * world, std::nullopt, std::nullopt};
+    if (image_) s.pixel = pixel_of(frame_.intrinsics, frame_.width, frame_.height, s.camera);
+    else s.cell = CubeRangeImage::cell_of(s.camera);
     return s;
   }
 
-  // In the image, and every measured depth of its pixel and the 8 around it is farther.
+  // In the image, and every measured depth of its pixel and the 8 around it is farther (for a
+  // cloud: at least one of its 9 cells measured, and all of them farther).
   bool seen_in_front(const Sight& s) const {
-    if (!usable_) return true;
+    if (s.cell) return cube_->farther_around(s.cell->index, s.cell->depth);
     if (!s.pixel) return false;
     const Pixel& px = *s.pixel;
     for (int y = std::max(px.v - 1, 0); y <= std::min(px.v + 1, frame_.height - 1); ++y)
@@ -124,11 +207,10 @@ class DepthView {
     return true;
   }
 
-  bool has_image() const { return usable_; }
-
-  // Projects less than `pixels` inside the image's edge (or outside the image).
+  // Projects less than `pixels` inside the image's edge (or outside the image); a cloud has no
+  // edge.
   bool at_edge(const Eigen::Vector3d& world, double pixels) const {
-    if (!usable_) return false;
+    if (!image_) return false;
     const std::optional<Eigen::Vector2d> p = projection(frame_.intrinsics, camera_T_world_ * world);
     if (!p) return false;
     const double inset = std::min(std::min(p->x() + 0.5, frame_.width - 0.5 - p->x()),
@@ -136,19 +218,18 @@ class DepthView {
     return inset < pixels;
   }
 
-  // In the image, and its own pixel measured a surface more than `margin` nearer.
+  // In the image, and its own pixel (or cell) measured a surface more than `margin` nearer.
   bool seen_behind(const Sight& s, double margin) const {
-    if (!s.pixel) return false;
-    const float d = depth_at(s.pixel->u, s.pixel->v);
-    return d > 0.0f && d < s.camera.z() - margin;
+    const float d = measured_depth(s);
+    return d > 0.0f && d < depth_of(s) - margin;
   }
 
-  // The world point that the point's pixel measured (none outside the image or where the
-  // pixel measured nothing).
+  // The world point that the point's pixel (or cell, at its centre) measured (none outside the
+  // image or where nothing was measured).
   std::optional<Eigen::Vector3d> measured(const Sight& s) const {
-    if (!s.pixel) return std::nullopt;
-    const double d = depth_at(s.pixel->u, s.pixel->v);
+    const double d = measured_depth(s);
     if (!(d > 0.0)) return std::nullopt;
+    if (s.cell) return frame_.world_T_camera * CubeRangeImage::point(s.cell->index, d);
     const PinholeIntrinsics& k = frame_.intrinsics;
     const Eigen::Vector3d camera((s.pixel->u - k.cx) / k.fx * d, (s.pixel->v - k.cy) / k.fy * d, d);
     return frame_.world_T_camera * camera;
@@ -156,10 +237,18 @@ class DepthView {
 
  private:
   float depth_at(int u, int v) const { return frame_.depth[static_cast<size_t>(v) * frame_.width + u]; }
+  // What the point's own pixel or cell measured (0: nothing, or outside the image).
+  float measured_depth(const Sight& s) const {
+    if (s.cell) return cube_->depth(s.cell->index);
+    return s.pixel ? depth_at(s.pixel->u, s.pixel->v) : 0.0f;
+  }
+  // The point's own depth, as its pixel or cell measures depth.
+  static double depth_of(const Sight& s) { return s.cell ? s.cell->depth : s.camera.z(); }
 
   const Frame& frame_;
   Eigen::Isometry3d camera_T_world_;
-  bool usable_;
+  bool image_;
+  std::optional<CubeRangeImage> cube_;  // frames without an image
 };
 
 // The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
@@ -752,15 +841,14 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
 }
 
 // Every voxel near the frame's points that no vote reached gets one free vote, which
-// voxel_update keeps only where the depth image shows its centre free. Beside a silhouette no
+// voxel_update keeps only where the depth image (or the cloud's cube) shows its centre free. Beside a silhouette no
 // surface point has free space in front of it and carving rays cross only voxels observed
 // before, so that space was never given a value, and marching cubes, which needs all eight
 // corners of a cube, ended the surface up to half a voxel short of the silhouette
 // (scenes/smoke.yaml: the ball's limb 2.5 cm short, and bins it enters read the wall behind).
 // The space then counts as observed and gathers carving votes; a person stepping into it is
 // in the map at once by the arrival rule (fuse_updates).
-void vote_beside_surfaces(const DepthView& view, const openvdb::MaskGrid& near, VoteGrid& counts) {
-  if (!view.has_image()) return;
+void vote_beside_surfaces(const openvdb::MaskGrid& near, VoteGrid& counts) {
   auto acc = counts.getAccessor();
   VoteCounts free_vote(0);
   free_vote[kFree] = 1;
@@ -827,19 +915,17 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
   // free votes of vote_beside_surfaces they made the surface bulge past the silhouette).
-  if (votes[kHitInside] > 0 && view.has_image() && seen_in_front()) votes[kHitInside] = 0;
+  if (votes[kHitInside] > 0 && seen_in_front()) votes[kHitInside] = 0;
   // Nor does a behind vote overturn space the map holds as free, unless an object arrived
   // there: the free space was seen, while a behind vote only guesses the object's depth. Seen
   // from its far side, a panel thinner than the votes' reach let them into the space seen
-  // free in front of it, and its near side moved up to 9 cm toward its viewer. (Without a
-  // depth image no arrival can be seen, and dropping them would keep an object that steps
-  // into free space out of the map for good.)
+  // free in front of it, and its near side moved up to 9 cm toward its viewer.
   std::optional<bool> arrived;  // arrival_seen(config, at, sight), asked at most once
   auto arrival = [&] {
     if (!arrived) arrived = arrival_seen(config, at, sight);
     return *arrived;
   };
-  if (votes[kHitInside] > 0 && view.has_image()) {
+  if (votes[kHitInside] > 0) {
     const openvdb::Vec2s old = at.map.getValue(voxel);
     if (old[1] > 0.0f && old[0] < 0.0f && !arrival()) votes[kHitInside] = 0;
   }
@@ -895,7 +981,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   VoteGrid counts(VoteCounts(0));
   SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
   count_votes(votes, counts, surface);
-  vote_beside_surfaces(view, local.near, counts);
+  vote_beside_surfaces(local.near, counts);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
   counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
