@@ -841,13 +841,13 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
 }
 
 // Every voxel near the frame's points that no vote reached gets one free vote, which
-// voxel_update keeps only where the depth image (or the cloud's cube) shows its centre free. Beside a silhouette no
-// surface point has free space in front of it and carving rays cross only voxels observed
-// before, so that space was never given a value, and marching cubes, which needs all eight
-// corners of a cube, ended the surface up to half a voxel short of the silhouette
-// (scenes/smoke.yaml: the ball's limb 2.5 cm short, and bins it enters read the wall behind).
-// The space then counts as observed and gathers carving votes; a person stepping into it is
-// in the map at once by the arrival rule (fuse_updates).
+// voxel_update keeps only where the depth image (or the cloud's cube) shows its centre free.
+// Beside a silhouette no surface point has free space in front of it and carving rays cross
+// only voxels observed before, so that space was never given a value, and marching cubes,
+// which needs all eight corners of a cube, ended the surface up to half a voxel short of the
+// silhouette (scenes/smoke.yaml: the ball's limb 2.5 cm short, and bins it enters read the wall
+// behind). The space then counts as observed and gathers carving votes; a person stepping into
+// it is in the map at once by the arrival rule (fuse_updates).
 void vote_beside_surfaces(const openvdb::MaskGrid& near, VoteGrid& counts) {
   auto acc = counts.getAccessor();
   VoteCounts free_vote(0);

@@ -307,14 +307,14 @@ std::string percent(int part, int whole) {
 // each of `classes` VDB-GPDF reads no more bins too far than the TSDF peer and than Open3D's
 // ScalableTSDFVolume (images only).
 void check_classes(std::initializer_list<int> classes, Input input) {
-  const auto mappers = ::mappers(input);
-  std::vector<Tally> tallies(mappers.size());
+  const auto makers = mappers(input);
+  std::vector<Tally> tallies(makers.size());
   for (uint64_t seed = 1; seed <= kRooms; ++seed) run_room(seed, input, tallies);
   std::ostringstream table;
   table << "| class | bins |";
-  for (const auto& m : mappers) table << ' ' << m.first << " off > 0.1 m (too far; strict; near) |";
+  for (const auto& m : makers) table << ' ' << m.first << " off > 0.1 m (too far; strict; near) |";
   table << "\n|---|---|";
-  for (size_t m = 0; m < mappers.size(); ++m) table << "---|";
+  for (size_t m = 0; m < makers.size(); ++m) table << "---|";
   table << '\n';
   for (int k = 0; k < kClassCount; ++k) {
     table << "| " << kClassNames[k] << " | " << tallies[0].bins[k] << " |";
@@ -324,10 +324,10 @@ void check_classes(std::initializer_list<int> classes, Input input) {
     table << '\n';
   }
   WARN(table.str());
-  for (size_t peer = 1; peer < mappers.size(); ++peer)
+  for (size_t peer = 1; peer < makers.size(); ++peer)
     for (int k : classes) {
       INFO(kClassNames[k] << ": too far vdb_gpdf " << tallies[0].far[k] << ", "
-                          << mappers[peer].first << ' ' << tallies[peer].far[k] << " of "
+                          << makers[peer].first << ' ' << tallies[peer].far[k] << " of "
                           << tallies[0].bins[k]);
       CHECK(tallies[0].bins[k] > 0);
       CHECK(tallies[0].far[k] <= tallies[peer].far[k]);
