@@ -185,7 +185,7 @@ constexpr int kMesh = 0, kRefused = 1, kWriteFailed = 2;
 constexpr size_t kMaxReason = 400;  // characters of a refusal shown
 
 template <typename T>
-bool write_all(ChildOutput& out, const std::vector<T>& items) {
+bool write_items(ChildOutput& out, const std::vector<T>& items) {
   return out.write(items.data(), items.size() * sizeof(T));
 }
 
@@ -197,7 +197,7 @@ int read_in_child(const fs::path& file, ChildOutput& out) {
                              : std::string("cannot read the mesh (") + importer.GetErrorString() + ")";
   if (!reason.empty()) return out.write(reason.data(), reason.size()) ? kRefused : kWriteFailed;
   const uint64_t counts[2] = {mesh.vertices.size(), mesh.triangles.size()};
-  return out.write(counts, sizeof counts) && write_all(out, mesh.vertices) && write_all(out, mesh.triangles) ? kMesh
+  return out.write(counts, sizeof counts) && write_items(out, mesh.vertices) && write_items(out, mesh.triangles) ? kMesh
                                                                                                               : kWriteFailed;
 }
 

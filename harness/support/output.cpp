@@ -80,20 +80,13 @@ void check_parent_writable(const fs::path& final_path) {
                      " is not writable");
 }
 
-// Every byte of `data` into a new file, fsynced; short writes continue, EINTR retries.
+// Every byte of `data` into a new file, fsynced (write_fully).
 void write_all(const fs::path& file, const std::string& data) {
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw_write_error("cannot create", file, errno);
-  std::size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::write(fd, data.data() + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int error = n < 0 ? errno : EIO;
-      ::close(fd);
-      throw_write_error("writing", file, error);
-    }
-    done += static_cast<std::size_t>(n);
+  if (const int error = write_fully(fd, data.data(), data.size()); error != 0) {
+    ::close(fd);
+    throw_write_error("writing", file, error);
   }
   if (::fsync(fd) != 0 && errno != EINVAL) {
     const int error = errno;
@@ -198,6 +191,18 @@ bool within(const fs::path& inner, const fs::path& outer) {
 }
 
 }  // namespace
+
+int write_fully(int fd, const void* data, std::size_t bytes) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    const ssize_t n = ::write(fd, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return n < 0 ? errno : EIO;
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+  }
+  return 0;
+}
 
 bool is_sonomap_result(const fs::path& dir) {
   std::error_code ec;

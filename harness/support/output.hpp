@@ -10,6 +10,7 @@
 // - an interrupt (interrupt.hpp) up to the publishing rename removes the staged output.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -103,5 +104,9 @@ void write_text_file(const std::filesystem::path& path, const std::string& text,
 
 // Closes a stream that wrote `file`; WriteError with the reason if any write to it failed.
 void close_checked(std::ofstream& stream, const std::filesystem::path& file);
+
+// Every byte of `data` to file descriptor `fd` (short writes continue, EINTR retries): 0, or
+// the errno that stopped it (EIO when a write wrote nothing).
+int write_fully(int fd, const void* data, std::size_t bytes);
 
 }  // namespace sonomap::harness

@@ -3,6 +3,7 @@
 
 #include "harness/support/errors.hpp"
 #include "harness/support/interrupt.hpp"
+#include "harness/support/output.hpp"
 
 #include <chrono>
 #include <csignal>
@@ -162,17 +163,7 @@ ChildOutput::ChildOutput() : fd_(::memfd_create("sonomap-child-output", MFD_CLOE
 
 ChildOutput::~ChildOutput() { ::close(fd_); }
 
-bool ChildOutput::write(const void* data, std::size_t bytes) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::write(fd_, p, bytes);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
+bool ChildOutput::write(const void* data, std::size_t bytes) { return write_fully(fd_, data, bytes) == 0; }
 
 std::string ChildOutput::read() const {
   struct stat info {};
@@ -242,15 +233,7 @@ PipedProgram::~PipedProgram() {
 }
 
 bool PipedProgram::write(const void* data, size_t bytes) {
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0 && stdin_fd_ >= 0) {
-    const ssize_t n = ::write(stdin_fd_, p, bytes);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<size_t>(n);
-  }
-  return stdin_fd_ >= 0;
+  return stdin_fd_ >= 0 && write_fully(stdin_fd_, data, bytes) == 0;
 }
 
 int PipedProgram::finish(std::string* output) {
