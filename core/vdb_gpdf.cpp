@@ -207,6 +207,8 @@ class DepthView {
     return true;
   }
 
+  bool has_image() const { return image_; }
+
   // Projects less than `pixels` inside the image's edge (or outside the image); a cloud has no
   // edge.
   bool at_edge(const Eigen::Vector3d& world, double pixels) const {
@@ -468,7 +470,9 @@ Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::
 // A source point's own vote is different: its voxel's value is the centre's signed offset from
 // the tangent plane (what a surface sample says of a voxel it lies in), not the GPs' distance,
 // which beyond a silhouette edge would push the surface sideways into free space.
-enum VoteKind { kHitInside, kFrontInside, kFree, kSurface };
+// "Lateral" votes carry a source's tangent plane one voxel sideways, in frames without a depth
+// image only (LeafQueries::add_lateral).
+enum VoteKind { kHitInside, kFrontInside, kFree, kSurface, kLateral };
 struct Vote {
   openvdb::Coord voxel;
   VoteKind kind;
@@ -478,6 +482,7 @@ using VoteCounts = openvdb::math::Vec3<int32_t>;  // per kind, kHitInside .. kFr
 using VoteGrid = openvdb::Grid<openvdb::tree::Tree4<VoteCounts, 5, 4, 3>::Type>;
 // Surface votes: (sum of positive offsets, their count, sum of negative offsets, their count).
 using SurfaceVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
+using LateralVoteGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec2s, 5, 4, 3>::Type>;  // offsets' sum, count
 
 // The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
 // cells, its GP training points and (after train_local_gps) its GP, and the global voxels near
@@ -725,9 +730,9 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
 class LeafQueries {
  public:
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
-              size_t leaf, const Eigen::Vector3d& origin)
+              size_t leaf, const Eigen::Vector3d& origin, bool lateral)
       : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
-        observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index) {}
+        lateral_(lateral), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index) {}
 
   std::vector<Vote> votes;
 
@@ -745,10 +750,12 @@ class LeafQueries {
     const GpPrediction at_p = gp_.predict(p, false, false);  // p lies in this leaf: its GP is the nearest
     const double d = at_p.valid ? at_p.distance : 0.0;
     cast(own, kSurface, static_cast<float>(-d - facing.dot(voxel_centre(own, vg_) - p)));
+    const bool trusted = normal.dot(u) > kMinNormalDotRay;  // zero normal: not trusted
+    if (lateral_ && trusted) add_lateral(own, p, facing, d);
     // Behind points along the normal, not the ray (behind points along a grazing ray leave
     // thin objects), and only where the normal is trusted: a view within 6 degrees of the
     // surface leaves its side in doubt, and a flipped normal puts "behind" in free space.
-    if (normal.dot(u) > kMinNormalDotRay)
+    if (trusted)
       for (int j = 1; j <= config_.trunc_behind; ++j) vote(p - j * config_.query_step * normal, p, facing, true);
     // Front points along the ray: the ray crossed that space, so it is free for sure.
     for (int j = 1; j <= config_.trunc_front; ++j) vote(p + j * config_.query_step * u, p, facing, false);
@@ -762,6 +769,24 @@ class LeafQueries {
     v.voxel = voxel;
     v.kind = kind;
     v.offset = offset;
+  }
+
+  // A sparse cloud, a lidar's rings, meets a surface along lines a few voxels apart. Its
+  // votes then observe a strip one voxel wide around each line, and marching cubes, which
+  // needs all eight corners of a cube, left most of it out: from every eighth row of the
+  // random box rooms' images, the circle read too far at 32 corner bins of 410 and 72 thin
+  // ones (the ray-traced TSDF peer, whose rays cross several voxels around each hit, 6 and
+  // 10). So each source also gives its tangent plane's offset to the 26 voxels around its own
+  // whose centres lie within a voxel of the plane; voxel_update uses them only where no other
+  // vote reached and the cloud did not see through the centre.
+  void add_lateral(const openvdb::Coord& own, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, double d) {
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const openvdb::Coord v = own.offsetBy(dx, dy, dz);
+          const double offset = -d - facing.dot(voxel_centre(v, vg_) - p);
+          if ((dx || dy || dz) && std::abs(offset) < vg_) cast(v, kLateral, static_cast<float>(offset));
+        }
   }
 
   void vote(const Eigen::Vector3d& q, const Eigen::Vector3d& p, const Eigen::Vector3d& facing, bool hit) {
@@ -813,6 +838,7 @@ class LeafQueries {
   const SurfaceGp& gp_;
   Eigen::Vector3d origin_;
   double vg_;
+  bool lateral_;
   DistanceWeightGrid::ConstAccessor observed_;
   const std::vector<LeafCells>& cells_;
   LocalGps::IndexAccessor index_;
@@ -820,11 +846,18 @@ class LeafQueries {
 
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
 // order: the result does not depend on the thread count.
-void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface) {
+void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface,
+                 LateralVoteGrid& lateral) {
   auto acc = counts.getAccessor();
   auto surface_acc = surface.getAccessor();
+  auto lateral_acc = lateral.getAccessor();
   for (const auto& leaf_votes : votes)
     for (const Vote& vote : leaf_votes) {
+      if (vote.kind == kLateral) {
+        lateral_acc.setValue(vote.voxel, lateral_acc.getValue(vote.voxel) + openvdb::Vec2s(vote.offset, 1.0f));
+        acc.setValueOn(vote.voxel);
+        continue;
+      }
       if (vote.kind == kSurface) {
         openvdb::Vec4f sums = surface_acc.getValue(vote.voxel);
         const int at = vote.offset > 0.0f ? 0 : 2;
@@ -900,7 +933,7 @@ bool arrival_seen(const VdbGpdfConfig& config, const UpdateLookups& at, const De
 // free vote near the surface needs the centre's pixel and its 8 neighbours to have measured
 // something farther (a front point or ray beside a grazing face passes a centre inside it).
 bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, VoteCounts votes,
-                  openvdb::Vec4f surface, const UpdateLookups& at, QueryUpdate& out) {
+                  openvdb::Vec4f surface, openvdb::Vec2s lateral, const UpdateLookups& at, QueryUpdate& out) {
   const DepthView& view = at.view;
   const Eigen::Vector3d centre = voxel_centre(voxel, config.global_voxel);
   const DepthView::Sight sight = view.sight(centre);  // projected once for every check below
@@ -909,6 +942,17 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
     if (!in_front) in_front = view.seen_in_front(sight);
     return *in_front;
   };
+  // Only lateral votes reached it (clouds: LeafQueries::add_lateral): their plane's offset,
+  // unless the cloud saw through the centre; then the free vote beside surfaces it stood in
+  // for (vote_beside_surfaces).
+  if (lateral[1] > 0.0f && votes == VoteCounts(0) && surface[1] + surface[3] == 0.0f) {
+    if (!seen_in_front()) {
+      const double weight = config.inverse_variance_fusion ? lateral[1] / config.variance_on_surface : lateral[1];
+      out = {voxel, lateral[0] / lateral[1], static_cast<float>(weight), true};
+      return true;
+    }
+    if (at.near.isValueOn(voxel)) votes[kFree] = 1;
+  }
   const bool behind = view.seen_behind(sight, kBehindMargin * config.global_voxel);
   if (surface[3] > 0 && behind) surface[2] = surface[3] = 0.0f;
   if (votes[kFree] > 0 && at.near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
@@ -973,14 +1017,15 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   const size_t leaves = local.sources.size();
   std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, fused, leaf, origin);
+    LeafQueries queries(config, local, fused, leaf, origin, !view.has_image());
     queries.votes.reserve(local.sources[leaf].size() * kVotesPerSource);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
     votes[leaf] = std::move(queries.votes);
   });
   VoteGrid counts(VoteCounts(0));
   SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
-  count_votes(votes, counts, surface);
+  LateralVoteGrid lateral(openvdb::Vec2s(0.0f));
+  count_votes(votes, counts, surface, lateral);
   vote_beside_surfaces(local.near, counts);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
   counts.tree().getNodes(vote_leaves);
@@ -988,10 +1033,13 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
     const UpdateLookups lookups{local.gps, local.near.getConstAccessor(), view, fused.getConstAccessor()};
     const auto surface_acc = surface.getConstAccessor();
+    const auto lateral_acc = lateral.getConstAccessor();
     QueryUpdate update;
-    for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v)
-      if (voxel_update(config, v.getCoord(), *v, surface_acc.getValue(v.getCoord()), lookups, update))
+    for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v) {
+      const openvdb::Coord& c = v.getCoord();
+      if (voxel_update(config, c, *v, surface_acc.getValue(c), lateral_acc.getValue(c), lookups, update))
         per_leaf[i].push_back(update);
+    }
   });
   std::vector<QueryUpdate> updates;
   for (const auto& leaf_updates : per_leaf) updates.insert(updates.end(), leaf_updates.begin(), leaf_updates.end());

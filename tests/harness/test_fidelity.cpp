@@ -226,8 +226,23 @@ ResolvableTruth resolvable_truth(const std::vector<eval::GroundTruthTriangle>& t
 }
 
 // What the maps are given: the camera's depth image (and its points), or its points only, as
-// an unorganised cloud from a recording arrives (Open3D's TSDF integrates images only).
-enum class Input { kImage, kCloud };
+// an unorganised cloud from a recording arrives, or the points of every kRingRows-th image row
+// only, as a spinning lidar's rings (Open3D's TSDF integrates images only).
+enum class Input { kImage, kCloud, kRings };
+constexpr int kRingRows = 8;  // 2.3 degrees apart: a 16-ring lidar's rings are 2 degrees apart
+
+// The frame as `input` says the maps get it.
+void keep_input(Input input, Frame& frame) {
+  if (input == Input::kImage) return;
+  frame.depth.clear();
+  if (input != Input::kRings) return;
+  std::vector<Eigen::Vector3f> rings;
+  for (const Eigen::Vector3f& p : frame.points_camera) {
+    const int row = static_cast<int>(std::floor(frame.intrinsics.fy * p.y() / p.z() + frame.intrinsics.cy));
+    if (row % kRingRows == 0) rings.push_back(p);
+  }
+  frame.points_camera = std::move(rings);
+}
 
 using MapperMaker = std::function<std::unique_ptr<Mapper>()>;
 std::vector<std::pair<std::string, MapperMaker>> mappers(Input input) {
@@ -250,7 +265,7 @@ void run_room(uint64_t seed, Input input, std::vector<Tally>& tallies) {
     const std::vector<Obstacle> now = room.at(i);
     const Scene scene = scene_of(now);
     Frame frame = test::render(scene, camera, i, kWidth, kHeight, 5.0, true);
-    if (input == Input::kCloud) frame.depth.clear();
+    keep_input(input, frame);
     for (auto& map : maps) map->integrate(frame);
     if (i < 6 || i % 3 != 2) continue;  // evaluate every third frame once the map has a start
     RasterOrigin origin;
@@ -351,4 +366,16 @@ TEST_CASE("Fidelity: from point clouds, in random box rooms VDB-GPDF reads no mo
           "peer at corners, low boxes, thin slabs, grazing faces and where a box left",
           "[fidelity]") {
   check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, Input::kCloud);
+}
+
+// A lidar's rings meet a surface along lines 2.3 degrees apart (8 cm at 2 m), and VDB-GPDF's
+// votes observed a strip one voxel wide around each: the surfaces between the rings and up to
+// the edges were not in its map. Before the lateral votes (main eeee382) it read too far at
+// 32 corner bins, 12 low, 72 thin, 18 grazing and 4 where the box left, the TSDF peer at 6, 0,
+// 10, 0 and 1. Thin slabs and grazing faces are still missed more than by the peer (19 and 6;
+// docs/fidelity.md), so this test holds the three classes where VDB-GPDF now matches it.
+TEST_CASE("Fidelity: from a lidar's rings, in random box rooms VDB-GPDF reads no more bins too far "
+          "than the TSDF peer at corners, low boxes and where a box left",
+          "[fidelity]") {
+  check_classes({kCorner, kLow, kVacated}, Input::kRings);
 }
