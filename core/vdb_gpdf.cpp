@@ -614,11 +614,19 @@ void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& g
   for (PointSumLeaves& bucket : buckets) bucket.move_into(grid);  // leaves in any order: the same tree
 }
 
+// A local leaf that a surface crosses holds about DIM x DIM = 64 occupied local voxels in a
+// depth image's frame, and voxel_downsample thins them. A lidar's ring crosses one as a line of
+// about 8, and every fifth of those left training points 10 cm apart, three of the local GPs'
+// length scales: from every eighth row of the random box rooms, 8 more bins too far at corners,
+// 11 at thin slabs (docs/fidelity.md, "A lidar's rings"). In a cloud, a leaf with fewer than half
+// a plane's voxels keeps every one.
+constexpr size_t kSparseLeafCells = LeafCells::Leaf::DIM * LeafCells::Leaf::DIM / 2;
+
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
-// centroids of every voxel_downsample-th occupied local voxel, not the voxel centres: centres put
-// a face up to half a local voxel inside or outside it), their box, and its cells; then the leaf
-// index and the neighbour links.
-void index_local_leaves(const VdbGpdfConfig& config, LocalFrame& out) {
+// centroids of every voxel_downsample-th occupied local voxel, or of every one in a cloud's
+// sparse leaf; not the voxel centres: centres put a face up to half a local voxel inside or
+// outside it), their box, and its cells; then the leaf index and the neighbour links.
+void index_local_leaves(const VdbGpdfConfig& config, bool cloud, LocalFrame& out) {
   std::vector<const PointSumGrid::TreeType::LeafNodeType*> leaves;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   const size_t n = leaves.size();
@@ -632,16 +640,17 @@ void index_local_leaves(const VdbGpdfConfig& config, LocalFrame& out) {
   cells.resize(n);
   parallel_for_each_index(n, [&](size_t i) {
     const size_t on = leaves[i]->onVoxelCount();
+    const int stride = cloud && on < kSparseLeafCells ? 1 : config.voxel_downsample;
     cells[i].cells.reserve(on);
-    cells[i].trained.reserve(on / config.voxel_downsample + 1);
-    out.training[i].reserve(on / config.voxel_downsample + 1);
+    cells[i].trained.reserve(on / stride + 1);
+    out.training[i].reserve(on / stride + 1);
     cells[i].cell_of.fill(-1);
     int k = 0;
     for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
       const Eigen::Vector3d c = centroid(*v);
       cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
-      if (k % config.voxel_downsample != 0) continue;
+      if (k % stride != 0) continue;
       out.training[i].push_back(c.cast<float>());
       cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
       gps.bounds[i].extend(out.training[i].back().cast<double>());
@@ -708,7 +717,7 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
 
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
-  index_local_leaves(config, out);
+  index_local_leaves(config, !view.has_image(), out);
   const std::vector<LeafCells>& cells = out.cells;
   openvdb::Int32Grid counts(0);
   parallel_both([&] { count_cells(cells, counts); }, [&] { near_surface(cells, out.near); });
