@@ -617,9 +617,9 @@ void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& g
 // A local leaf that a surface crosses holds about DIM x DIM = 64 occupied local voxels in a
 // depth image's frame, and voxel_downsample thins them. A lidar's ring crosses one as a line of
 // about 8, and every fifth of those left training points 10 cm apart, three of the local GPs'
-// length scales: from every eighth row of the random box rooms, 8 more bins too far at corners,
-// 11 at thin slabs (docs/fidelity.md, "A lidar's rings"). In a cloud, a leaf with fewer than half
-// a plane's voxels keeps every one.
+// length scales: from every eighth row of the random box rooms, 3 more bins too far at corners,
+// 11 at thin slabs and 2 at grazing faces (docs/fidelity.md, "A lidar's rings"). In a cloud, a
+// leaf with fewer than half a plane's voxels keeps every one.
 constexpr size_t kSparseLeafCells = LeafCells::Leaf::DIM * LeafCells::Leaf::DIM / 2;
 
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
