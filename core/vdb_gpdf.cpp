@@ -175,7 +175,7 @@ class DepthView {
   explicit DepthView(const Frame& frame)
       : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
         image_(has_depth_image(frame)) {  // throws when the image is not width x height
-    if (!image_) cube_.emplace(frame.points_camera);
+    if (!image_) cube_ = std::make_unique<const CubeRangeImage>(frame.points_camera);
   }
 
   // A world point as the camera sees it: its camera coordinates and its pixel (none outside
@@ -250,7 +250,9 @@ class DepthView {
   const Frame& frame_;
   Eigen::Isometry3d camera_T_world_;
   bool image_;
-  std::optional<CubeRangeImage> cube_;  // frames without an image
+  // Frames without an image. (A std::optional here drew GCC 12's -Wmaybe-uninitialized on its
+  // vector in the sanitizer build, a false report.)
+  std::unique_ptr<const CubeRangeImage> cube_;
 };
 
 // The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
