@@ -18,7 +18,9 @@ FieldTable vdb_gpdf_fields(VdbGpdfConfig& c) {
   return {
       number("local_voxel", &c.local_voxel, "m", kMinVoxel, 1.0, "per-frame temporary grid voxel size (`--voxel` keeps it at 0.4 voxels)"),
       whole("voxel_downsample", &c.voxel_downsample, 1, 1000,
-            "keep every n-th active local voxel as a GP training point"),
+            "keep every n-th active local voxel as a GP training point (in frames without a "
+            "depth image, a local leaf with fewer than 32 active voxels keeps every one: "
+            "docs/fidelity.md, \"A lidar's rings\")"),
       voxel,
       {"kernel", kernel, "", {}, "GP kernel of the local and global GPs"},
       positive("lambda", &c.lambda, "1/m^2", 1e8, "kernel parameter: 1 / lengthscale^2 (`--voxel` keeps the lengthscale at 2/3 voxel)"),
