@@ -17,6 +17,7 @@
 #include "harness/support/errors.hpp"
 #include "harness/support/output.hpp"
 #include "harness/support/progress.hpp"
+#include "sim/cloud_frame.hpp"
 #include "sim/simulation.hpp"
 
 #include <fmt/format.h>
@@ -54,6 +55,10 @@ struct BenchMapOptions {
   std::vector<double> voxels{0.05, 0.10, 0.15};
   std::vector<int> threads{1, 2};
   std::vector<std::string> mappers{"vdb_gpdf", "tsdf", kOpen3d};
+  // What the mappers get: the depth image and its points ("image"), or the points alone
+  // ("cloud"), of every row_step-th image row only when row_step > 1 (a lidar's rings).
+  std::string input = "image";
+  int row_step = 1;
   std::string json;
 };
 
@@ -122,6 +127,27 @@ double median_nearest_distance(const std::vector<Eigen::Vector3f>& from,
   return distances.empty() ? NAN : median(std::move(distances));
 }
 
+// The input, as printed and written: what the mappers were given, and its points per frame.
+struct InputSummary {
+  std::string text;
+  double median_points = 0.0;
+  double row_spacing_deg = NAN;  // cloud rows, at the image's centre
+};
+InputSummary summarise_input(const BenchMapOptions& o, const sim::Scenario& scenario, const std::vector<Frame>& frames) {
+  std::vector<double> points;
+  for (const Frame& f : frames) points.push_back(static_cast<double>(f.points_camera.size()));
+  InputSummary s{"", points.empty() ? 0.0 : median(points)};
+  if (o.input == "image") {
+    s.text = fmt::format("depth images and their points ({:.0f} points a frame)", s.median_points);
+    return s;
+  }
+  s.row_spacing_deg = std::atan(o.row_step / scenario.camera.fy) * 180.0 / M_PI;
+  s.text = o.row_step == 1 ? fmt::format("points only ({:.0f} a frame)", s.median_points)
+                           : fmt::format("points of every {}-th image row only, {:.2f} degrees apart ({:.0f} a frame)",
+                                         o.row_step, s.row_spacing_deg, s.median_points);
+  return s;
+}
+
 // The OpenMP runtime reads OMP_WAIT_POLICY once, when it loads: record what it was.
 const char* omp_wait_policy() { return std::getenv("OMP_WAIT_POLICY"); }
 
@@ -130,6 +156,8 @@ double process_peak_rss_mb() {
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // Linux reports KiB
 }
+
+constexpr int kMaxRowStep = 100000;
 
 void check_options(const BenchMapOptions& o) {
   if (o.frames < 1) throw InputError("--frames must be at least 1, got " + std::to_string(o.frames));
@@ -149,6 +177,13 @@ void check_options(const BenchMapOptions& o) {
       throw InputError("--mappers " + m + ": unknown mapper (known: " + known + ")");
     }
   }
+  if (o.row_step < 1 || o.row_step > kMaxRowStep)
+    throw InputError(fmt::format("--row-step must be in [1, {}], got {}", kMaxRowStep, o.row_step));
+  if (o.row_step > 1 && o.input != "cloud")
+    throw InputError("--row-step " + std::to_string(o.row_step) + " thins a cloud: give --input cloud");
+  if (o.input == "cloud" && std::find(o.mappers.begin(), o.mappers.end(), kOpen3d) != o.mappers.end())
+    throw InputError("--mappers open3d: Open3D's TSDF fuses depth images, and --input cloud gives "
+                     "points only (leave open3d out, or bench --input image)");
   if (!o.json.empty()) {
     const std::filesystem::path parent = std::filesystem::path(o.json).parent_path();
     if (!parent.empty() && !std::filesystem::is_directory(parent))
@@ -164,6 +199,7 @@ std::vector<Frame> render_frames(const sim::Scenario& scenario, const BenchMapOp
   std::vector<Frame> frames;
   for (long i = 0; i < o.frames && i * o.every < simulation.frame_count(); ++i) {
     frames.push_back(simulation.render(static_cast<int>(i * o.every)));
+    if (o.input == "cloud") sim::keep_cloud(frames.back(), o.row_step);
     progress.update(++done);
   }
   return frames;
@@ -272,7 +308,7 @@ std::vector<Scaling> scalings(const std::vector<CellResult>& results) {
 }
 
 void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const std::vector<Frame>& frames,
-                const std::vector<CellResult>& results, const std::vector<ReferenceCheck>& checks,
+                const InputSummary& input, const std::vector<CellResult>& results, const std::vector<ReferenceCheck>& checks,
                 double rss_peak_mb, double rss_frames_mb) {
   const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
   json out{{"scenario", {{"name", scenario.name}, {"file", o.scenario}}},
@@ -280,6 +316,10 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
            {"frames", json::array()},
            {"every", o.every},
            {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
+           {"input", {{"kind", o.input},
+                      {"row_step", o.row_step},
+                      {"row_spacing_deg", number(input.row_spacing_deg)},
+                      {"median_points", input.median_points}}},
            {"vector_loops", name_of(vector_isa())},
            {"open3d", {{"class", "ScalableTSDFVolume"},
                        {"sdf_trunc_voxels", kPeer.truncation / kPeer.voxel},
@@ -340,6 +380,7 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   long done = 0;
   const std::vector<Frame> frames = render_frames(scenario, o, progress, done);
   const double rss_frames_mb = process_peak_rss_mb();
+  const InputSummary input = summarise_input(o, scenario, frames);
 
   std::vector<CellResult> results;
   std::vector<ReferenceCheck> checks;
@@ -364,6 +405,7 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), {} loops, medians per frame in ms\n",
              scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every,
              name_of(vector_isa()));
+  fmt::print("input: {}\n", input.text);
   fmt::print("map = the mapper's integrate (open3d: depth copy + Integrate, truncation {:g} voxels); "
              "raster = circle + cylinder\nfrom the map's surface samples (as `run`; open3d: mesh "
              "extraction included); frame = map + raster;\ncpu = process CPU time of the frame (all "
@@ -402,7 +444,7 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
 
   const bool reference_ok =
       std::all_of(checks.begin(), checks.end(), [](const ReferenceCheck& c) { return c.passed(); });
-  if (!o.json.empty()) write_json(o, scenario, frames, results, checks, rss_peak_mb, rss_frames_mb);
+  if (!o.json.empty()) write_json(o, scenario, frames, input, results, checks, rss_peak_mb, rss_frames_mb);
   if (!reference_ok)
     throw std::runtime_error("bench map: the Open3D reference failed its check (its surface is not "
                              "within a voxel of our TSDF's): the ratios are not valid");
@@ -425,6 +467,14 @@ void add_bench_map(CLI::App& bench, const GlobalOptions& global) {
       ->delimiter(',')->capture_default_str();
   cmd->add_option("--mappers", options->mappers, "Mappers: vdb_gpdf, tsdf, depth_only, open3d")
       ->delimiter(',')->capture_default_str();
+  cmd->add_option("--input", options->input,
+                  "image: depth images and their points; cloud: the points only, as a recording's "
+                  "unorganised cloud (open3d fuses images only)")
+      ->check(CLI::IsMember({"image", "cloud"}))->capture_default_str();
+  cmd->add_option("--row-step", options->row_step,
+                  "With --input cloud: keep every N-th image row's points only, lines across each "
+                  "surface as a spinning lidar's rings (18 rows of a 525 px focal length: 2 degrees)")
+      ->capture_default_str();
   cmd->add_option("--json", options->json, "Write the results as JSON (atomically)");
   cmd->callback([options, &global] { bench_map(*options, global); });
 }

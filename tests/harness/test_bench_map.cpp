@@ -127,3 +127,39 @@ TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0 and no frames,
   CHECK_THAT(no_frames.output, Catch::Contains("--frames"));
   CHECK(sonomap::test::nothing_written(file));
 }
+
+TEST_CASE("bench map times the mappers on clouds and a lidar's rings, and refuses Open3D there",
+          "[cli][bench]") {
+  const sonomap::test::ScratchDir scratch("bench-map-cloud");
+  const auto points_of = [&](const std::vector<std::string>& input) {
+    const fs::path file = scratch.path() / ("bench" + std::to_string(input.size()) + ".json");
+    auto arguments = bench_map_arguments(file);
+    arguments.insert(arguments.end(), {"--mappers", "vdb_gpdf,tsdf"});
+    arguments.insert(arguments.end(), input.begin(), input.end());
+    const auto result = run_sonomap(arguments);
+    INFO(result.output);
+    REQUIRE(result.status == 0);
+    const json bench = json::parse(sonomap::test::text_of(file));
+    for (const json& row : bench.at("results")) CHECK(row.at("median_ms").at("frame").get<double>() > 0.0);
+    CHECK(bench.at("results").size() == 2);
+    CHECK(bench.at("input").at("kind") == (input.empty() ? "image" : "cloud"));
+    return bench.at("input").at("median_points").get<double>();
+  };
+  const double image = points_of({});
+  const double rings = points_of({"--input", "cloud", "--row-step", "18"});
+  // Rows 0, 18, ..., 468: 27 of the 480 rows.
+  CHECK(rings == Approx(image * 27.0 / 480.0).epsilon(0.1));
+
+  const fs::path refused = scratch.path() / "refused.json";
+  auto with_open3d = bench_map_arguments(refused);
+  with_open3d.insert(with_open3d.end(), {"--input", "cloud"});
+  const auto open3d = run_sonomap(with_open3d);
+  CHECK(open3d.status == 2);
+  CHECK_THAT(open3d.output, Catch::Contains("open3d") && Catch::Contains("--input cloud"));
+  auto image_step = bench_map_arguments(refused);
+  image_step.insert(image_step.end(), {"--row-step", "8"});
+  const auto step = run_sonomap(image_step);
+  CHECK(step.status == 2);
+  CHECK_THAT(step.output, Catch::Contains("--row-step"));
+  CHECK(sonomap::test::nothing_written(refused));
+}

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Exact (noise-free) depth against closed-form geometry.
 #include "scenes.hpp"
+#include "sim/cloud_frame.hpp"
 #include "sim/depth_camera.hpp"
 #include "sim/simulation.hpp"
 #include "sim/world.hpp"
@@ -222,4 +223,27 @@ TEST_CASE("the incidence angle is acos within float rounding, the same with any 
   CHECK(worst < 2.3e-8);
   CHECK(incidence_angle(1.0f) == 0.0f);
   CHECK(incidence_angle(2.0f) == 0.0f);  // rounding beyond 1 is clamped
+}
+
+TEST_CASE("a wall 2 m ahead as a lidar's rings: every 8th row's 640 points, on lines 2 m away, no image",
+          "[sim][camera]") {
+  Simulation sim(test::wall_scenario(2.0));
+  Frame rings = sim.render(0);
+  keep_cloud(rings, 8);
+  CHECK(rings.depth.empty());  // a cloud: the mappers get no image beside it
+  REQUIRE(rings.points_camera.size() == 60u * 640u);  // rows 0, 8, ..., 472
+  int off_wall = 0, off_ring = 0;
+  for (const Eigen::Vector3f& p : rings.points_camera) {
+    off_wall += std::abs(p.z() - 2.0f) > 1e-4f;
+    // Back on the image, each point lies on a row that is a multiple of 8 (y = (v - cy) z / fy).
+    const double row = p.y() / p.z() * rings.intrinsics.fy + rings.intrinsics.cy;
+    off_ring += std::abs(row - 8.0 * std::round(row / 8.0)) > 1e-3;
+  }
+  CHECK(off_wall == 0);
+  CHECK(off_ring == 0);
+  Frame cloud = sim.render(0);
+  keep_cloud(cloud);  // every row: the image's points, without the image
+  CHECK(cloud.depth.empty());
+  CHECK(cloud.points_camera.size() == 640u * 480u);
+  CHECK_THROWS_AS(keep_cloud(cloud, 0), std::invalid_argument);
 }
