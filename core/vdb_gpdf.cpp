@@ -428,39 +428,86 @@ class NormalNeighbourhood {
   std::array<const LeafCells*, 8> leaves_{};
 };
 
-// The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
-// centroids of the occupied local voxels within two voxels of p's (up to 57, about 25 on a
-// plane). Returns zero where the neighbourhood is too small for a plane.
-// (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
-// views that point can still lie behind the sampled surface, the gradient then points into the
-// object, and front points land inside it: measured 13 cm deep in a box.)
-Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c,
-                               const Eigen::Vector3d& p, const Eigen::Vector3d& u) {
-  // The sums of d and of d d^T's six distinct terms, kept as scalars: Eigen's outer product
-  // builds a 3x3 temporary whose partly overlapping stores and loads stalled store-to-load
-  // forwarding (13% of this function's samples on one instruction).
+// The scatter of points about p, as scalar sums: Eigen's outer product builds a 3x3 temporary
+// whose partly overlapping stores and loads stalled store-to-load forwarding (13% of the
+// normal's samples on one instruction).
+struct Scatter {
   double sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
   int count = 0;
-  static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
-  for (const auto& [dx, dy, dz] : kBall) {
-    const Eigen::Vector3d* at = local.centroid(c.offsetBy(dx, dy, dz));
-    if (!at) continue;
-    const Eigen::Vector3d d = *at - p;  // relative to p: well conditioned
+  void add(const Eigen::Vector3d& d) {  // d relative to p: well conditioned
     sx += d.x(), sy += d.y(), sz += d.z();
     xx += d.x() * d.x(), xy += d.x() * d.y(), xz += d.x() * d.z();
     yy += d.y() * d.y(), yz += d.y() * d.z(), zz += d.z() * d.z();
     ++count;
   }
-  if (count < 5) return Eigen::Vector3d::Zero();
-  const Eigen::Vector3d mean = Eigen::Vector3d(sx, sy, sz) / count;
+};
+
+// A plane through the scatter: its normal facing u (zero when the points are too few for a
+// plane), and whether they lie along a line, for which any plane through it fits as well.
+struct PlaneFit {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  bool line = false;
+};
+constexpr double kRingSpacingDeg = 3.0;  // the widest ring spacing a widened neighbourhood bridges
+constexpr double kLineSpread = 0.2;  // second eigenvalue below this share of the largest: a line
+PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
+  if (s.count < 5) return {};
+  const Eigen::Vector3d mean = Eigen::Vector3d(s.sx, s.sy, s.sz) / s.count;
   Eigen::Matrix3d outer;
-  outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  outer << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-  eig.computeDirect(outer / count - mean * mean.transpose());
+  eig.computeDirect(outer / s.count - mean * mean.transpose());
   Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
-  if (eig.info() != Eigen::Success || !n.allFinite()) return Eigen::Vector3d::Zero();
+  if (eig.info() != Eigen::Success || !n.allFinite()) return {};
   n.normalize();
-  return n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n;
+  return {n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n, eig.eigenvalues()[1] < kLineSpread * eig.eigenvalues()[2]};
+}
+
+// The local voxels' centroids of a local leaf and its neighbours within `reach` of p: where a
+// lidar's ring crosses a surface, the ball around p holds that ring only, and the next ring
+// (2 degrees on: 7 cm at 2 m) shows which plane through the ring is the surface.
+struct WideNeighbourhood {
+  const std::vector<LeafCells>& cells;
+  const LocalGps& leaves;  // their centres and neighbours
+  size_t leaf;
+  Scatter around(const Eigen::Vector3d& p, double reach) const {
+    Scatter s;
+    const double half = kLeafDim * 0.5 * leaves.voxel;
+    auto add_leaf = [&](size_t i) {
+      const Eigen::Vector3d outside = ((leaves.centres[i] - p).cwiseAbs().array() - half).cwiseMax(0.0);
+      if (outside.squaredNorm() > reach * reach) return;  // the leaf lies out of reach
+      for (const auto& cell : cells[i].cells)
+        if ((cell.centroid - p).squaredNorm() <= reach * reach) s.add(cell.centroid - p);
+    };
+    add_leaf(leaf);
+    for (int j : leaves.neighbours[leaf]) add_leaf(static_cast<size_t>(j));
+    return s;
+  }
+};
+
+// The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
+// centroids of the occupied local voxels within two voxels of p's (up to 57, about 25 on a
+// plane). Returns zero where the neighbourhood is too small for a plane. In a cloud (`wide`
+// given), a neighbourhood along a line, as a lidar's ring crosses a surface, fits any plane
+// through the line: it is widened to `wide_reach` to take in the next ring, and where that
+// still holds a line only, the normal is zero too. From the ball alone, the random box rooms
+// from rings one image row each read too far at 37 corner bins of 410, 52 low and 106 thin
+// (docs/fidelity.md, "Rings one row each").
+// (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
+// views that point can still lie behind the sampled surface, the gradient then points into the
+// object, and front points land inside it: measured 13 cm deep in a box.)
+Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c, const Eigen::Vector3d& p,
+                               const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach) {
+  Scatter ball;
+  static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
+  for (const auto& [dx, dy, dz] : kBall) {
+    const Eigen::Vector3d* at = local.centroid(c.offsetBy(dx, dy, dz));
+    if (at) ball.add(*at - p);
+  }
+  const PlaneFit fit = fit_plane(ball, u);
+  if (!fit.line || !wide) return fit.normal;
+  const PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
+  return widened.line ? Eigen::Vector3d::Zero() : widened.normal;
 }
 
 // What one query point or carving ray says of the global voxel it falls in. The value itself
@@ -743,7 +790,8 @@ class LeafQueries {
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
               size_t leaf, const Eigen::Vector3d& origin, bool lateral)
       : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
-        lateral_(lateral), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index) {}
+        lateral_(lateral), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index),
+        wide_{local.cells, local.gps, leaf} {}
 
   std::vector<Vote> votes;
 
@@ -753,7 +801,8 @@ class LeafQueries {
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const openvdb::Coord c = voxel_of(p, config_.local_voxel);
-    const Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u);
+    const Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
+                                                  lateral_ ? &wide_ : nullptr, ring_reach(range));
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
@@ -774,6 +823,13 @@ class LeafQueries {
   }
 
  private:
+  // How far a ring's neighbourhood is widened: past the next ring of a lidar whose rings are up
+  // to kRingSpacingDeg apart, beyond the ball, within the leaves around (one leaf's width).
+  double ring_reach(double range) const {
+    return std::clamp(std::tan(kRingSpacingDeg * M_PI / 180.0) * range, (kNormalReach + 1) * config_.local_voxel,
+                      LeafCells::Leaf::DIM * config_.local_voxel);
+  }
+
   // Appends a vote field by field (as append_run: no Vote built on the stack and copied).
   void cast(const openvdb::Coord& voxel, VoteKind kind, float offset = 0.0f) {
     Vote& v = votes.emplace_back();
@@ -853,6 +909,7 @@ class LeafQueries {
   DistanceWeightGrid::ConstAccessor observed_;
   const std::vector<LeafCells>& cells_;
   LocalGps::IndexAccessor index_;
+  WideNeighbourhood wide_;
 };
 
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
