@@ -8,9 +8,9 @@
 
 namespace sonomap::sim {
 
-// Drops the frame's depth image and, with row_step > 1, every point whose pixel row (its
-// projection, rounded) is not a multiple of row_step. Throws std::invalid_argument for
-// row_step < 1.
+// Drops the frame's depth image and, with row_step > 1, every point whose pixel (pixel_of:
+// the nearest pixel centre) is not on a row that is a multiple of row_step. Throws
+// std::invalid_argument for row_step < 1.
 void keep_cloud(Frame& frame, int row_step = 1);
 
 }  // namespace sonomap::sim
