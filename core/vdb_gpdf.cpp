@@ -54,7 +54,7 @@ constexpr double kNewSurfaceVoxels = 0.5;
 // says nothing of how thin the object is: a panel may end a centimetre behind its face. Next
 // to a free voxel beside a silhouette or beyond a thin object's hidden side, a large inside
 // value pulled the marching cubes' crossing past the object: with the free votes beside
-// silhouettes (vote_beside_surfaces) and no cap, the random box rooms of docs/fidelity.md had
+// silhouettes (vote_free_where_unvoted) and no cap, the random box rooms of docs/fidelity.md had
 // 16 readings too near (11 with the cap), and on the smoke scene a box's corner ran 8 mm into
 // the next bin.
 constexpr double kInsideCapVoxels = 0.5;
@@ -519,9 +519,10 @@ Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::
 // A source point's own vote is different: its voxel's value is the centre's signed offset from
 // the tangent plane (what a surface sample says of a voxel it lies in), not the GPs' distance,
 // which beyond a silhouette edge would push the surface sideways into free space.
-// "Lateral" votes carry a source's tangent plane one voxel sideways, in frames without a depth
-// image only (LeafQueries::add_lateral).
-enum VoteKind { kHitInside, kFrontInside, kFree, kSurface, kLateral };
+// "Lateral" votes carry a source's tangent plane one voxel sideways, and "beside a ray" votes
+// a carving ray's free space one voxel up and down, in frames without a depth image only
+// (LeafQueries::add_lateral, LeafQueries::beside_ray).
+enum VoteKind { kHitInside, kFrontInside, kFree, kSurface, kLateral, kBesideRay };
 struct Vote {
   openvdb::Coord voxel;
   VoteKind kind;
@@ -897,8 +898,24 @@ class LeafQueries {
         // where its values are 4 kB (their cache misses cost about 1 ms of a 5 cm room frame).
         if (leaf_origin_of(v) != block || !leaf->isValueOn(v)) continue;
         cast(v, kFree);
+        if (lateral_ && leaf->getValue(v)[0] > 0.0f) beside_ray(v);  // held inside: the object left
       } while (walk.step());
     } while (blocks.step());
+  }
+
+  // A lidar's rings cross space a few voxels apart (7 cm at 2 m for rings 2 degrees apart), so
+  // where an object left, rows of voxels between two rings were crossed by no ray and kept its
+  // old surface (random box rooms from rings: 17 bins read too near where the box had stood,
+  // the TSDF peer 9; a level lidar's rings cross the same rows every sweep, and the ghost
+  // stayed for good). Where a ray carves a voxel the map held inside an object, the observed
+  // voxels just above and below get a vote "beside a ray": one free vote where no other vote
+  // of the frame reached (vote_free_where_unvoted). Only there: beside space the map already
+  // held free, a ray passing just above a table top 4 cm thick between two rings would carve it.
+  void beside_ray(const openvdb::Coord& v) {
+    for (const int dz : {-1, 1}) {
+      const openvdb::Coord n = v.offsetBy(0, 0, dz);
+      if (observed_.isValueOn(n)) cast(n, kBesideRay);
+    }
   }
 
   const VdbGpdfConfig& config_;
@@ -915,12 +932,17 @@ class LeafQueries {
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
 // order: the result does not depend on the thread count.
 void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface,
-                 LateralVoteGrid& lateral) {
+                 LateralVoteGrid& lateral, openvdb::MaskGrid& beside_rays) {
   auto acc = counts.getAccessor();
   auto surface_acc = surface.getAccessor();
   auto lateral_acc = lateral.getAccessor();
+  auto beside_acc = beside_rays.getAccessor();
   for (const auto& leaf_votes : votes)
     for (const Vote& vote : leaf_votes) {
+      if (vote.kind == kBesideRay) {
+        beside_acc.setValueOn(vote.voxel);
+        continue;
+      }
       if (vote.kind == kLateral) {
         lateral_acc.setValue(vote.voxel, lateral_acc.getValue(vote.voxel) + openvdb::Vec2s(vote.offset, 1.0f));
         acc.setValueOn(vote.voxel);
@@ -941,19 +963,21 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
     }
 }
 
-// Every voxel near the frame's points that no vote reached gets one free vote, which
-// voxel_update keeps only where the depth image (or the cloud's cube) shows its centre free.
-// Beside a silhouette no surface point has free space in front of it and carving rays cross
-// only voxels observed before, so that space was never given a value, and marching cubes,
-// which needs all eight corners of a cube, ended the surface up to half a voxel short of the
-// silhouette (scenes/smoke.yaml: the ball's limb 2.5 cm short, and bins it enters read the wall
-// behind). The space then counts as observed and gathers carving votes; a person stepping into
-// it is in the map at once by the arrival rule (fuse_updates).
-void vote_beside_surfaces(const openvdb::MaskGrid& near, VoteGrid& counts) {
+// Every voxel of `voxels` that no vote reached gets one free vote, which voxel_update keeps
+// near the frame's surfaces only where the depth image (or the cloud's cube) shows its centre
+// free. Called for the voxels near the frame's points, and for a cloud's voxels beside its
+// carving rays (LeafQueries::beside_ray). Near the points: beside a silhouette no surface
+// point has free space in front of it and carving rays cross only voxels observed before, so
+// that space was never given a value, and marching cubes, which needs all eight corners of a
+// cube, ended the surface up to half a voxel short of the silhouette (scenes/smoke.yaml: the
+// ball's limb 2.5 cm short, and bins it enters read the wall behind). The space then counts as
+// observed and gathers carving votes; a person stepping into it is in the map at once by the
+// arrival rule (fuse_updates).
+void vote_free_where_unvoted(const openvdb::MaskGrid& voxels, VoteGrid& counts) {
   auto acc = counts.getAccessor();
   VoteCounts free_vote(0);
   free_vote[kFree] = 1;
-  for (auto v = near.cbeginValueOn(); v; ++v)
+  for (auto v = voxels.cbeginValueOn(); v; ++v)
     if (!acc.isValueOn(v.getCoord())) acc.setValue(v.getCoord(), free_vote);
 }
 
@@ -1012,7 +1036,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   };
   // Only lateral votes reached it (clouds: LeafQueries::add_lateral): their plane's offset,
   // unless the cloud saw through the centre; then the free vote beside surfaces it stood in
-  // for (vote_beside_surfaces).
+  // for (vote_free_where_unvoted).
   if (lateral[1] > 0.0f && votes == VoteCounts(0) && surface[1] + surface[3] == 0.0f) {
     if (!seen_in_front()) {
       const double weight = config.inverse_variance_fusion ? lateral[1] / config.variance_on_surface : lateral[1];
@@ -1026,7 +1050,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   if (votes[kFree] > 0 && at.near.isValueOn(voxel) && !seen_in_front()) votes[kFree] = 0;
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
-  // free votes of vote_beside_surfaces they made the surface bulge past the silhouette).
+  // free votes of vote_free_where_unvoted they made the surface bulge past the silhouette).
   if (votes[kHitInside] > 0 && seen_in_front()) votes[kHitInside] = 0;
   // Nor does a behind vote overturn space the map holds as free, unless an object arrived
   // there: the free space was seen, while a behind vote only guesses the object's depth. Seen
@@ -1093,8 +1117,10 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   VoteGrid counts(VoteCounts(0));
   SurfaceVoteGrid surface(openvdb::Vec4f(0.0f));
   LateralVoteGrid lateral(openvdb::Vec2s(0.0f));
-  count_votes(votes, counts, surface, lateral);
-  vote_beside_surfaces(local.near, counts);
+  openvdb::MaskGrid beside_rays(false);
+  count_votes(votes, counts, surface, lateral, beside_rays);
+  vote_free_where_unvoted(local.near, counts);
+  vote_free_where_unvoted(beside_rays, counts);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
   counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());

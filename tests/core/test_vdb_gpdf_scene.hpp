@@ -130,6 +130,31 @@ inline Frame render(const Scene& scene, const Eigen::Isometry3d& world_T_camera,
   return f;
 }
 
+// A spinning lidar's sweep as a frame without a depth image: `rings` cones of rays at
+// elevations lowest_deg, lowest_deg + spacing_deg, ... above the horizontal at the sensor,
+// every azimuth_step_deg all around, noise-free, the hits within max_range as points in the
+// frame of `world_T_camera` (any pose: a cloud has no image to match).
+inline Frame lidar_sweep(const Scene& scene, const Eigen::Vector3d& sensor, const Eigen::Isometry3d& world_T_camera,
+                         int index, int rings = 16, double lowest_deg = -15.0, double spacing_deg = 2.0,
+                         double azimuth_step_deg = 0.2, double max_range = 5.0) {
+  Frame f;
+  f.index = index;
+  f.world_T_camera = world_T_camera;
+  f.world_T_body = world_T_camera;
+  const Eigen::Isometry3d camera_T_world = world_T_camera.inverse();
+  const int azimuths = static_cast<int>(std::lround(360.0 / azimuth_step_deg));
+  for (int r = 0; r < rings; ++r) {
+    const double e = (lowest_deg + r * spacing_deg) * M_PI / 180.0;
+    for (int a = 0; a < azimuths; ++a) {
+      const double az = a * azimuth_step_deg * M_PI / 180.0;
+      const Eigen::Vector3d dir(std::cos(e) * std::cos(az), std::cos(e) * std::sin(az), std::sin(e));
+      const double t = scene.cast(sensor, dir);
+      if (t <= max_range) f.points_camera.push_back((camera_T_world * (sensor + t * dir)).cast<float>());
+    }
+  }
+  return f;
+}
+
 // Poses on a circle of `radius` around `target`, `height` above it, all looking at it.
 inline std::vector<Eigen::Isometry3d> orbit(const Eigen::Vector3d& target, double radius,
                                             double height, int count) {
