@@ -197,8 +197,9 @@ std::array<bool, kClassCount> classify(const Obstacle& o, const Eigen::Vector3d&
 
 struct Tally {
   // far: read too far or not at all (one pixel's tolerance); strict_far: without it; near:
-  // read nearer than the truth by over 0.1 m even with the bin turned a pixel either way
-  // (reported, not checked: a map's surface running past a silhouette)
+  // read nearer than the truth by over 0.1 m even with the bin turned a pixel either way (a
+  // map's surface running past a silhouette; checked in the classes where VDB-GPDF matches its
+  // peers, docs/fidelity.md)
   std::array<int, kClassCount> bins{}, off{}, far{}, strict_far{}, near{};
 };
 
@@ -313,8 +314,8 @@ std::string percent(int part, int whole) {
 
 // Runs the seeded rooms, prints the per-class table (docs/fidelity.md) and checks that in
 // each of `classes` VDB-GPDF reads no more bins too far than the TSDF peer and than Open3D's
-// ScalableTSDFVolume (images only).
-void check_classes(std::initializer_list<int> classes, Input input) {
+// ScalableTSDFVolume (images only), and in each of `near_classes` no more bins too near.
+void check_classes(std::initializer_list<int> classes, std::initializer_list<int> near_classes, Input input) {
   const auto makers = mappers(input);
   std::vector<Tally> tallies(makers.size());
   for (uint64_t seed = 1; seed <= kRooms; ++seed) run_room(seed, input, tallies);
@@ -340,15 +341,24 @@ void check_classes(std::initializer_list<int> classes, Input input) {
       CHECK(tallies[0].bins[k] > 0);
       CHECK(tallies[0].far[k] <= tallies[peer].far[k]);
     }
+  for (size_t peer = 1; peer < makers.size(); ++peer)
+    for (int k : near_classes) {
+      INFO(kClassNames[k] << ": too near vdb_gpdf " << tallies[0].near[k] << ", "
+                          << makers[peer].first << ' ' << tallies[peer].near[k] << " of "
+                          << tallies[0].bins[k]);
+      CHECK(tallies[0].near[k] <= tallies[peer].near[k]);
+    }
 }
 
 }  // namespace
 
+// Too near, VDB-GPDF's surface runs past a 3 cm panel seen end on at grazing faces (3 bins
+// against the peers' 2; docs/fidelity.md, "Readings too near"): that class is not held.
 TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
           "peer or Open3D's TSDF at corners, low boxes, thin slabs, grazing faces and where a "
-          "box left",
+          "box left, and no more too near but at grazing faces",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, Input::kImage);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kCorner, kLow, kThin, kVacated}, Input::kImage);
 }
 
 // The same rooms from points only: VDB-GPDF then sees its frame's surfaces in a range image of
@@ -358,7 +368,7 @@ TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far tha
 TEST_CASE("Fidelity: from point clouds, in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
           "peer at corners, low boxes, thin slabs, grazing faces and where a box left",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, Input::kCloud);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {}, Input::kCloud);
 }
 
 // A lidar's rings meet a surface along lines 2.3 degrees apart (8 cm at 2 m). Along one line
@@ -367,9 +377,12 @@ TEST_CASE("Fidelity: from point clouds, in random box rooms VDB-GPDF reads no mo
 // corner bins, 52 low, 106 thin, 25 grazing and 4 where the box left (main 786c751), the TSDF
 // peer at 6, 0, 9, 0 and 2. A ring's normal now reaches the next ring. Grazing faces are still
 // missed more than by the peer (2 against 0; docs/fidelity.md), so this test holds the four
-// classes where VDB-GPDF matches it.
+// classes where VDB-GPDF matches it. Too near, objects from rings come out wider (lateral
+// votes), but where the box left VDB-GPDF reads fewer bins too near than the peer (2 against
+// 9; 17 before the rows between two rings were freed beside the carving rays).
 TEST_CASE("Fidelity: from a lidar's rings, in random box rooms VDB-GPDF reads no more bins too far "
-          "than the TSDF peer at corners, low boxes, thin slabs and where a box left",
+          "than the TSDF peer at corners, low boxes, thin slabs and where a box left, and no more too "
+          "near where a box left",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kVacated}, Input::kRings);
+  check_classes({kCorner, kLow, kThin, kVacated}, {kVacated}, Input::kRings);
 }
