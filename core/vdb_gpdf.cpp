@@ -981,6 +981,46 @@ void vote_free_where_unvoted(const openvdb::MaskGrid& voxels, VoteGrid& counts) 
     if (!acc.isValueOn(v.getCoord())) acc.setValue(v.getCoord(), free_vote);
 }
 
+// A lidar's rings cross the same heights sweep after sweep. Where an object left, the old
+// surface at its edges stayed as single voxels held inside, each between two rows that rays
+// cross but held free on either side, so that no ray crosses a voxel held inside beside them
+// (LeafQueries::beside_ray): a spinning lidar's box left its vertical edges in the circle for
+// good. A voxel held inside with no voxel around it held inside is an object thinner than a
+// voxel every way; right above or below a voxel a ray crossed in this frame (a free vote), and
+// reached by no vote of its own, it is marked beside a ray too. (A counter top between two
+// rings has its neighbours along the top held inside: it stays.)
+void mark_lone_inside_beside_rays(const VoteGrid& counts, const DistanceWeightGrid& fused,
+                                  openvdb::MaskGrid& beside_rays) {
+  std::vector<const VoteGrid::TreeType::LeafNodeType*> leaves;
+  counts.tree().getNodes(leaves);
+  std::vector<std::vector<openvdb::Coord>> found(leaves.size());
+  parallel_for_each_index(leaves.size(), [&](size_t i) {
+    const auto voted = counts.getConstAccessor();
+    const auto map = fused.getConstAccessor();
+    auto held_inside = [&](const openvdb::Coord& c) {
+      openvdb::Vec2s value;
+      return map.probeValue(c, value) && value[0] > 0.0f;
+    };
+    auto alone = [&](const openvdb::Coord& n) {
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz)
+            if ((dx || dy || dz) && held_inside(n.offsetBy(dx, dy, dz))) return false;
+      return true;
+    };
+    for (auto v = leaves[i]->cbeginValueOn(); v; ++v) {
+      if ((*v)[kFree] == 0) continue;
+      for (const int dz : {-1, 1}) {
+        const openvdb::Coord n = v.getCoord().offsetBy(0, 0, dz);
+        if (!voted.isValueOn(n) && held_inside(n) && alone(n)) found[i].push_back(n);
+      }
+    }
+  });
+  auto mask = beside_rays.getAccessor();
+  for (const auto& coords : found)
+    for (const openvdb::Coord& n : coords) mask.setValueOn(n);
+}
+
 // What a voxel's update reads besides its votes: the frame's local GPs, its voxels near the
 // points, its depth image and the map as it was before the frame (one per task: accessors).
 struct UpdateLookups {
@@ -1119,6 +1159,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   LateralVoteGrid lateral(openvdb::Vec2s(0.0f));
   openvdb::MaskGrid beside_rays(false);
   count_votes(votes, counts, surface, lateral, beside_rays);
+  if (!view.has_image()) mark_lone_inside_beside_rays(counts, fused, beside_rays);
   vote_free_where_unvoted(local.near, counts);
   vote_free_where_unvoted(beside_rays, counts);
   std::vector<const VoteGrid::TreeType::LeafNodeType*> vote_leaves;
