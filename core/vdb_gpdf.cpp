@@ -1159,6 +1159,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   LateralVoteGrid lateral(openvdb::Vec2s(0.0f));
   openvdb::MaskGrid beside_rays(false);
   count_votes(votes, counts, surface, lateral, beside_rays);
+  // Before the free votes below, which no ray cast: a free vote counted so far is a ray crossing.
   if (!view.has_image()) mark_lone_inside_beside_rays(counts, fused, beside_rays);
   vote_free_where_unvoted(local.near, counts);
   vote_free_where_unvoted(beside_rays, counts);
