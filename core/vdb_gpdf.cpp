@@ -29,6 +29,9 @@ constexpr double kMinNormalDotRay = 0.1;  // sin 5.7 degrees
 // A surface point's negative value is dropped at a centre the camera saw more than this many
 // voxels behind the measured surface (see LeafQueries::fuse).
 constexpr double kBehindMargin = 0.25;
+// A behind vote is dropped at a centre whose own pixel measured a surface more than this many
+// voxels beyond it (depth noise's room; 0 and 1 gave the same fidelity figures).
+constexpr double kSeenPastVoxels = 0.5;
 // A global voxel without a training point gets a query source of its own only when its
 // frame points fill this many local voxels: a patch of surface, not a lone mixed pixel beside
 // a silhouette (one or two of those made a box's edge run 5 cm into free space; a corner seen
@@ -218,6 +221,12 @@ class DepthView {
     const double inset = std::min(std::min(p->x() + 0.5, frame_.width - 0.5 - p->x()),
                                   std::min(p->y() + 0.5, frame_.height - 0.5 - p->y()));
     return inset < pixels;
+  }
+
+  // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
+  bool seen_past(const Sight& s, double margin) const {
+    const float d = measured_depth(s);
+    return d > 0.0f && d > depth_of(s) + margin;
   }
 
   // In the image, and its own pixel (or cell) measured a surface more than `margin` nearer.
@@ -1091,7 +1100,11 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // A point behind the surface whose centre the camera saw through is not inside: beside a
   // silhouette the normal leans sideways and its behind points land in free space (with the
   // free votes of vote_free_where_unvoted they made the surface bulge past the silhouette).
-  if (votes[kHitInside] > 0 && seen_in_front()) votes[kHitInside] = 0;
+  // Seen through by its own pixel is enough to drop the guess (not to carve: a free vote needs
+  // all 9 pixels): at a panel's end the 9 pixels include the panel, and behind votes along the
+  // end's diagonal normals put the panel's hidden side past where the rays went on.
+  if (votes[kHitInside] > 0 && (seen_in_front() || view.seen_past(sight, kSeenPastVoxels * config.global_voxel)))
+    votes[kHitInside] = 0;
   // Nor does a behind vote overturn space the map holds as free, unless an object arrived
   // there: the free space was seen, while a behind vote only guesses the object's depth. Seen
   // from its far side, a panel thinner than the votes' reach let them into the space seen

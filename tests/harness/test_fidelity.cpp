@@ -366,10 +366,13 @@ TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far tha
 // its own (a cube of cells around the camera). Without it, every check against the image was
 // skipped for clouds: rays carved the edges off and the circle read too far at 28 corner bins
 // of 410, 22 thin ones, 8 low and 15 grazing (main f8f54f6; the TSDF peer 6, 5, 1 and 0).
+// Too near, it matches the ray-traced peer at thin slabs only (none; one before behind votes
+// were dropped where the centre's own cell measured past it): elsewhere the peer reads none.
 TEST_CASE("Fidelity: from point clouds, in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
-          "peer at corners, low boxes, thin slabs, grazing faces and where a box left",
+          "peer at corners, low boxes, thin slabs, grazing faces and where a box left, and no more too "
+          "near at thin slabs",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {}, Input::kCloud);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kThin}, Input::kCloud);
 }
 
 // A lidar's rings meet a surface along lines 2.3 degrees apart (8 cm at 2 m). Along one line
