@@ -9,6 +9,8 @@
 // the TSDF peer or Open3D in any class in view, nor read more bins too near in the classes
 // where it matches them today (docs/fidelity.md). The table is printed (WARN) for docs/fidelity.md:
 //   build/tests/test_harness "[fidelity]"
+// Other rooms than the four the tests hold, to see whether a change holds beyond them:
+//   SONOMAP_FIDELITY_SEEDS=5-12 build/tests/test_harness "[fidelity]"
 #include "core/open3d_tsdf.hpp"
 #include "core/rasteriser.hpp"
 #include "core/tsdf.hpp"
@@ -21,6 +23,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iomanip>
 #include <memory>
@@ -35,7 +39,10 @@ namespace {
 constexpr double kOff = 0.1;          // m
 constexpr double kHead = 1.5;         // m
 constexpr double kPitchDeg = 15.0;
-constexpr int kRooms = 4;
+// Seeds 1 .. kRooms, unless SONOMAP_FIDELITY_SEEDS says otherwise. Four rooms were too few: a
+// class's count moved by one or two bins with any change, and rooms 5-12 overturned three of the
+// verdicts the first four gave (docs/fidelity.md, "Twelve rooms").
+constexpr int kRooms = 12;
 constexpr int kFrames = 24;
 constexpr int kMoveFrame = 12;        // the large box jumps away before this frame
 constexpr int kWidth = 240, kHeight = 180;
@@ -313,13 +320,27 @@ std::string percent(int part, int whole) {
   return s.str();
 }
 
+// The seeds to run: 1 .. kRooms, or "first-last" from SONOMAP_FIDELITY_SEEDS (1 <= first <= last
+// <= 10000; anything else fails the test rather than running other rooms than asked for).
+std::pair<uint64_t, uint64_t> seed_range() {
+  const char* text = std::getenv("SONOMAP_FIDELITY_SEEDS");
+  if (!text) return {1, kRooms};
+  unsigned long first = 0, last = 0;
+  int used = 0;
+  const bool parsed = std::sscanf(text, "%lu-%lu%n", &first, &last, &used) == 2 && text[used] == '\0';
+  INFO("SONOMAP_FIDELITY_SEEDS=" << text << ": expected first-last, 1 <= first <= last <= 10000");
+  REQUIRE((parsed && first >= 1 && first <= last && last <= 10000));
+  return {first, last};
+}
+
 // Runs the seeded rooms, prints the per-class table (docs/fidelity.md) and checks that in
 // each of `classes` VDB-GPDF reads no more bins too far than the TSDF peer and than Open3D's
 // ScalableTSDFVolume (images only), and in each of `near_classes` no more bins too near.
 void check_classes(std::initializer_list<int> classes, std::initializer_list<int> near_classes, Input input) {
   const auto makers = mappers(input);
   std::vector<Tally> tallies(makers.size());
-  for (uint64_t seed = 1; seed <= kRooms; ++seed) run_room(seed, input, tallies);
+  const auto [first, last] = seed_range();
+  for (uint64_t seed = first; seed <= last; ++seed) run_room(seed, input, tallies);
   std::ostringstream table;
   table << "| class | bins |";
   for (const auto& m : makers) table << ' ' << m.first << " off > 0.1 m (too far; strict; near) |";
@@ -353,40 +374,39 @@ void check_classes(std::initializer_list<int> classes, std::initializer_list<int
 
 }  // namespace
 
-// Too near, VDB-GPDF's surface runs past a 3 cm panel seen end on at grazing faces (3 bins
-// against the peers' 2; docs/fidelity.md, "Readings too near"): that class is not held.
+// Too near, VDB-GPDF's surfaces run up to half a voxel past a box's corner or a panel's end
+// seen end on, and at low boxes that reads 3 bins too near against the peers' 2 (of 630 in
+// twelve rooms; docs/fidelity.md, "Twelve rooms"): that class is not held.
 TEST_CASE("Fidelity: in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
           "peer or Open3D's TSDF at corners, low boxes, thin slabs, grazing faces and where a "
-          "box left, and no more too near except at grazing faces",
+          "box left, and no more too near except at low boxes",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kCorner, kLow, kThin, kVacated}, Input::kImage);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kCorner, kThin, kGrazing, kVacated}, Input::kImage);
 }
 
 // The same rooms from points only: VDB-GPDF then sees its frame's surfaces in a range image of
 // its own (a cube of cells around the camera). Without it, every check against the image was
 // skipped for clouds: rays carved the edges off and the circle read too far at 28 corner bins
 // of 410, 22 thin ones, 8 low and 15 grazing (main f8f54f6; the TSDF peer 6, 5, 1 and 0).
-// Too near, it matches the ray-traced peer at thin slabs only (none; one before behind votes
-// were dropped where the centre's own cell measured past it): elsewhere the peer reads none.
+// Too near, it reads more bins than the ray-traced peer, which reads none in any class: the
+// lateral votes widen table legs and panels' ends by up to a voxel (docs/fidelity.md,
+// "Twelve rooms"). No class of readings too near is held.
 TEST_CASE("Fidelity: from point clouds, in random box rooms VDB-GPDF reads no more bins too far than the TSDF "
-          "peer at corners, low boxes, thin slabs, grazing faces and where a box left, and no more too "
-          "near at thin slabs",
+          "peer at corners, low boxes, thin slabs, grazing faces and where a box left",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kThin}, Input::kCloud);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {}, Input::kCloud);
 }
 
 // A lidar's rings meet a surface along lines 2.3 degrees apart (8 cm at 2 m). Along one line
 // any plane through it fits the points, and VDB-GPDF took its normals from a ball that holds
 // one ring only; with the rings one image row each (sim::keep_cloud) it read too far at 37
 // corner bins, 52 low, 106 thin, 25 grazing and 4 where the box left (main 786c751), the TSDF
-// peer at 6, 0, 9, 0 and 2. A ring's normal now reaches the next ring. Grazing faces are still
-// missed more than by the peer (2 against 0; docs/fidelity.md), so this test holds the four
-// classes where VDB-GPDF matches it. Too near, objects from rings come out wider (lateral
-// votes), but where the box left VDB-GPDF reads fewer bins too near than the peer (2 against
-// 9; 17 before the rows between two rings were freed beside the carving rays).
+// peer at 6, 0, 9, 0 and 2. A ring's normal now reaches the next ring. Too near, objects from
+// rings come out wider (lateral votes), but where the box left VDB-GPDF reads fewer bins too
+// near than the peer (8 against 37 in twelve rooms).
 TEST_CASE("Fidelity: from a lidar's rings, in random box rooms VDB-GPDF reads no more bins too far "
-          "than the TSDF peer at corners, low boxes, thin slabs and where a box left, and no more too "
-          "near where a box left",
+          "than the TSDF peer at corners, low boxes, thin slabs, grazing faces and where a box left, "
+          "and no more too near where a box left",
           "[fidelity]") {
-  check_classes({kCorner, kLow, kThin, kVacated}, {kVacated}, Input::kRings);
+  check_classes({kCorner, kLow, kThin, kGrazing, kVacated}, {kVacated}, Input::kRings);
 }
