@@ -9,8 +9,8 @@
 // the TSDF peer or Open3D in any class in view, nor read more bins too near in the classes
 // where it matches them today (docs/fidelity.md). The table is printed (WARN) for docs/fidelity.md:
 //   build/tests/test_harness "[fidelity]"
-// Other rooms than the four the tests hold, to see whether a change holds beyond them:
-//   SONOMAP_FIDELITY_SEEDS=5-12 build/tests/test_harness "[fidelity]"
+// Other rooms than the twelve the tests hold, to see whether a change holds beyond them:
+//   SONOMAP_FIDELITY_SEEDS=13-40 build/tests/test_harness "[fidelity]"
 #include "core/open3d_tsdf.hpp"
 #include "core/rasteriser.hpp"
 #include "core/tsdf.hpp"
