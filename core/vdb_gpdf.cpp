@@ -61,6 +61,14 @@ constexpr double kNewSurfaceVoxels = 0.5;
 // 16 readings too near (11 with the cap), and on the smoke scene a box's corner ran 8 mm into
 // the next bin.
 constexpr double kInsideCapVoxels = 0.5;
+// The widest spacing of a lidar's rings that a ring's neighbourhood (surface_normal) and a
+// lateral vote (CubeRangeImage::measured_around) bridge.
+constexpr double kRingSpacingDeg = 3.0;
+// A lateral vote beyond what a cloud measured (the sensor's field of view ends there) stands
+// only where a measured surface within kRingSpacingDeg lies within this many voxels of its
+// range: the surface ran on up to the view's edge. At 2 voxels, rings missed more at the
+// view's edge (random box rooms, low boxes: 2 against the TSDF peer's 1).
+constexpr double kRunsOnVoxels = 4.0;
 // Votes reserved per source: its own, 2 behind, 3 in front and the carving ray's (6-7 on
 // average in the room at 5 cm), so that a leaf's vote list rarely grows by copying.
 constexpr size_t kVotesPerSource = 16;
@@ -101,12 +109,20 @@ class CubeRangeImage {
   static constexpr int kCubeCells = 360;
 
   explicit CubeRangeImage(const std::vector<Eigen::Vector3f>& points) : depth_(6 * kCubeCells * kCubeCells, 0.0f) {
+    std::vector<int> cells;
+    cells.reserve(points.size());
     for (const Eigen::Vector3f& p : points) {
       const std::optional<Cell> c = cell_of(p.cast<double>());
       if (!c) continue;
       float& d = depth_[c->index];
       if (d == 0.0f || c->depth < d) d = static_cast<float>(c->depth);
+      cells.push_back(c->index);
     }
+    // Dense: most measured cells have another within two cells along both axes of their face
+    // (a lidar's rings are several cells apart across them).
+    size_t surrounded = 0;
+    for (const int index : cells) surrounded += measured_nearby(index, 1, 0) && measured_nearby(index, 0, 1);
+    dense_ = 2 * surrounded > cells.size();
   }
 
   // A camera-frame point's cell and its depth along the cell's face axis (none at the camera or
@@ -144,6 +160,44 @@ class CubeRangeImage {
   // The nearest depth measured in the cell (0: none).
   float depth(int index) const { return depth_[static_cast<size_t>(index)]; }
 
+  // Whether the cloud measured around camera-frame point c (in cell `index`), so that a
+  // lateral vote there fills a gap instead of running past what the sensor saw: its own cell
+  // measured; or cells on both sides of it within kRingSpacingDeg (between two rings); or,
+  // beyond the field of view's edge, the nearest measured cell in eight directions within
+  // `tolerance` of c's range (the surface ran on up to the edge), and for a dense cloud no
+  // more than `dense_reach` from c. Votes beyond the view were never checked by a later frame:
+  // a table's corner that stayed just below the view grew 7.6 cm past it (docs/fidelity.md).
+  bool measured_around(const Eigen::Vector3d& c, int index, double tolerance, double dense_reach) const {
+    if (depth_[static_cast<size_t>(index)] > 0.0f) return true;
+    const Eigen::Vector3d d = c.normalized();
+    Eigen::Vector3d a = d.cross(Eigen::Vector3d::UnitX());
+    if (a.norm() < 0.1) a = d.cross(Eigen::Vector3d::UnitY());
+    a.normalize();
+    const Eigen::Vector3d b = d.cross(a);
+    const double range = c.norm();
+    int nearest_step = std::numeric_limits<int>::max();
+    bool runs_on = false;  // at the nearest measured cell (the view's edge lies across it)
+    auto measured_along = [&](const Eigen::Vector3d& axis) {
+      const std::optional<Measured> m = first_measured(d, axis);
+      if (!m) return false;
+      const bool close = std::abs(m->range - range) < tolerance;
+      if (m->step < nearest_step) runs_on = close;
+      else if (m->step == nearest_step) runs_on = runs_on || close;
+      nearest_step = std::min(nearest_step, m->step);
+      return true;
+    };
+    const bool a_up = measured_along(a), a_down = measured_along(-a);
+    const bool b_up = measured_along(b), b_down = measured_along(-b);
+    if ((a_up && a_down) || (b_up && b_down)) return true;
+    for (const Eigen::Vector3d& diagonal : {Eigen::Vector3d((a + b).normalized()), Eigen::Vector3d((a - b).normalized())}) {
+      measured_along(diagonal);
+      measured_along(-diagonal);
+    }
+    // A dense cloud's surfaces end where its points end: a vote runs on past the edge by a
+    // voxel at most (a lidar's rings leave gaps at the view's edge as wide as their spacing).
+    return runs_on && (!dense_ || nearest_step * std::tan(kStepDeg * M_PI / 180.0) * range <= dense_reach);
+  }
+
   // The camera-frame point at `depth` along the centre of cell `index`.
   static Eigen::Vector3d point(int index, double depth) {
     const int u = index % kCubeCells, v = (index / kCubeCells) % kCubeCells, face = index / (kCubeCells * kCubeCells);
@@ -156,12 +210,46 @@ class CubeRangeImage {
   }
 
  private:
+  struct Measured {
+    int step;  // of kStepDeg
+    double range;
+  };
+  // The first measured cell from unit direction d turning toward `axis`, in steps finer than
+  // the cells at a face's edge, up to kRingSpacingDeg (none: nothing measured).
+  std::optional<Measured> first_measured(const Eigen::Vector3d& d, const Eigen::Vector3d& axis) const {
+    const double step = std::tan(kStepDeg * M_PI / 180.0);
+    const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
+    for (int k = 1; k <= steps; ++k) {
+      const Eigen::Vector3d q = d + (k * step) * axis;
+      const std::optional<Cell> c = cell_of(q);
+      if (!c || !(depth_[static_cast<size_t>(c->index)] > 0.0f)) continue;
+      const int face_axis = c->index / (kCubeCells * kCubeCells) / 2;
+      return Measured{k, depth_[static_cast<size_t>(c->index)] * q.norm() / std::abs(q[face_axis])};
+    }
+    return std::nullopt;
+  }
+
+  // Whether a cell one or two steps of (du, dv) away on the cell's face, either way, measured.
+  bool measured_nearby(int index, int du, int dv) const {
+    const int u = index % kCubeCells, v = (index / kCubeCells) % kCubeCells;
+    for (int k : {-2, -1, 1, 2}) {
+      const int x = u + k * du, y = v + k * dv;
+      if (x >= 0 && x < kCubeCells && y >= 0 && y < kCubeCells &&
+          depth_[static_cast<size_t>(index + (y - v) * kCubeCells + (x - u))] > 0.0f)
+        return true;
+    }
+    return false;
+  }
+
   // [-1, 1] on the face to a cell column or row.
   static int cell_coordinate(double t) {
     return std::clamp(static_cast<int>(std::floor((t + 1.0) * 0.5 * kCubeCells)), 0, kCubeCells - 1);
   }
 
+  static constexpr double kStepDeg = 0.15;  // finer than a cell at a face's edge (0.16 degree)
+
   std::vector<float> depth_;
+  bool dense_ = false;  // a depth camera's cloud, not a lidar's rings (the constructor)
 };
 
 // The frame's depth image (or its cloud's cube) seen from the world: whether a point lies in
@@ -221,6 +309,12 @@ class DepthView {
     const double inset = std::min(std::min(p->x() + 0.5, frame_.width - 0.5 - p->x()),
                                   std::min(p->y() + 0.5, frame_.height - 0.5 - p->y()));
     return inset < pixels;
+  }
+
+  // For a cloud, whether it measured around the point (CubeRangeImage::measured_around); an
+  // image measured every pixel.
+  bool measured_around(const Sight& s, double tolerance, double dense_reach) const {
+    return !s.cell || cube_->measured_around(s.camera, s.cell->index, tolerance, dense_reach);
   }
 
   // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
@@ -457,7 +551,6 @@ struct PlaneFit {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   bool line = false;
 };
-constexpr double kRingSpacingDeg = 3.0;  // the widest ring spacing a widened neighbourhood bridges
 constexpr double kLineSpread = 0.2;  // second eigenvalue below this share of the largest: a line
 PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
   if (s.count < 5) return {};
@@ -1083,11 +1176,12 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
     if (!in_front) in_front = view.seen_in_front(sight);
     return *in_front;
   };
-  // Only lateral votes reached it (clouds: LeafQueries::add_lateral): their plane's offset,
-  // unless the cloud saw through the centre; then the free vote beside surfaces it stood in
-  // for (vote_free_where_unvoted).
+  // Only lateral votes reached it (clouds: LeafQueries::add_lateral): their plane's offset
+  // where the cloud measured around the centre; where it saw through the centre, the free
+  // vote beside surfaces it stood in for (vote_free_where_unvoted).
   if (lateral[1] > 0.0f && votes == VoteCounts(0) && surface[1] + surface[3] == 0.0f) {
     if (!seen_in_front()) {
+      if (!view.measured_around(sight, kRunsOnVoxels * config.global_voxel, config.global_voxel)) return false;
       const double weight = config.inverse_variance_fusion ? lateral[1] / config.variance_on_surface : lateral[1];
       out = {voxel, lateral[0] / lateral[1], static_cast<float>(weight), true};
       return true;
