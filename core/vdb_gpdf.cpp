@@ -66,8 +66,9 @@ constexpr double kInsideCapVoxels = 0.5;
 constexpr double kRingSpacingDeg = 3.0;
 // A lateral vote beyond what a cloud measured (the sensor's field of view ends there) stands
 // only where a measured surface within kRingSpacingDeg lies within this many voxels of its
-// range: the surface ran on up to the view's edge. At 2 voxels, rings missed more at the
-// view's edge (random box rooms, low boxes: 2 against the TSDF peer's 1).
+// range: the surface ran on up to the view's edge. At 2 voxels (in a first form of the rule,
+// any measured cell in eight directions), rings missed more at the view's edge (random box
+// rooms, low boxes: 2 against the TSDF peer's 1).
 constexpr double kRunsOnVoxels = 4.0;
 // Votes reserved per source: its own, 2 behind, 3 in front and the carving ray's (6-7 on
 // average in the room at 5 cm), so that a leaf's vote list rarely grows by copying.
