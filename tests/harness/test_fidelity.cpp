@@ -430,7 +430,8 @@ TEST_CASE("Fidelity: from a dense cloud, a table whose corner stays just below t
   }
   REQUIRE(kept.size() == 4 + 5 + 1);
   room.obstacles = kept;
-  room.mover_before = room.mover_after = footprint_box(-3.0, 3.0, 0.2, 0.2, 0.0, 0.3);  // a corner, out of view
+  // No box jumps here: the mover, shrunk to 0.2 x 0.2 x 0.3 m, stays in a corner of the room.
+  room.mover_before = room.mover_after = footprint_box(-3.0, 3.0, 0.2, 0.2, 0.0, 0.3);
   const Scene scene = scene_of(room.at(0));
   std::vector<Box> now;
   for (const Obstacle& o : room.at(0)) now.push_back(o.box);
