@@ -165,10 +165,10 @@ class CubeRangeImage {
   // lateral vote there fills a gap instead of running past what the sensor saw: its own cell
   // measured; or cells on both sides of it within kRingSpacingDeg (between two rings); or,
   // beyond the field of view's edge, the nearest measured cell in eight directions within
-  // `tolerance` of c's range (the surface ran on up to the edge), and for a dense cloud no
-  // more than `dense_reach` from c. Votes beyond the view were never checked by a later frame:
+  // kRunsOnVoxels of c's range (the surface ran on up to the edge), and for a dense cloud no
+  // more than a voxel from c. Votes beyond the view were never checked by a later frame:
   // a table's corner that stayed just below the view grew 7.6 cm past it (docs/fidelity.md).
-  bool measured_around(const Eigen::Vector3d& c, int index, double tolerance, double dense_reach) const {
+  bool measured_around(const Eigen::Vector3d& c, int index, double voxel) const {
     if (depth_[static_cast<size_t>(index)] > 0.0f) return true;
     const Eigen::Vector3d d = c.normalized();
     Eigen::Vector3d a = d.cross(Eigen::Vector3d::UnitX());
@@ -181,7 +181,7 @@ class CubeRangeImage {
     auto measured_along = [&](const Eigen::Vector3d& axis) {
       const std::optional<Measured> m = first_measured(d, axis);
       if (!m) return false;
-      const bool close = std::abs(m->range - range) < tolerance;
+      const bool close = std::abs(m->range - range) < kRunsOnVoxels * voxel;
       if (m->step < nearest_step) runs_on = close;
       else if (m->step == nearest_step) runs_on = runs_on || close;
       nearest_step = std::min(nearest_step, m->step);
@@ -196,7 +196,7 @@ class CubeRangeImage {
     }
     // A dense cloud's surfaces end where its points end: a vote runs on past the edge by a
     // voxel at most (a lidar's rings leave gaps at the view's edge as wide as their spacing).
-    return runs_on && (!dense_ || nearest_step * std::tan(kStepDeg * M_PI / 180.0) * range <= dense_reach);
+    return runs_on && (!dense_ || nearest_step * kStepTangent * range <= voxel);
   }
 
   // The camera-frame point at `depth` along the centre of cell `index`.
@@ -218,10 +218,9 @@ class CubeRangeImage {
   // The first measured cell from unit direction d turning toward `axis`, in steps finer than
   // the cells at a face's edge, up to kRingSpacingDeg (none: nothing measured).
   std::optional<Measured> first_measured(const Eigen::Vector3d& d, const Eigen::Vector3d& axis) const {
-    const double step = std::tan(kStepDeg * M_PI / 180.0);
     const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
     for (int k = 1; k <= steps; ++k) {
-      const Eigen::Vector3d q = d + (k * step) * axis;
+      const Eigen::Vector3d q = d + (k * kStepTangent) * axis;
       const std::optional<Cell> c = cell_of(q);
       if (!c || !(depth_[static_cast<size_t>(c->index)] > 0.0f)) continue;
       const int face_axis = c->index / (kCubeCells * kCubeCells) / 2;
@@ -248,6 +247,7 @@ class CubeRangeImage {
   }
 
   static constexpr double kStepDeg = 0.15;  // finer than a cell at a face's edge (0.16 degree)
+  static inline const double kStepTangent = std::tan(kStepDeg * M_PI / 180.0);
 
   std::vector<float> depth_;
   bool dense_ = false;  // a depth camera's cloud, not a lidar's rings (the constructor)
@@ -314,8 +314,8 @@ class DepthView {
 
   // For a cloud, whether it measured around the point (CubeRangeImage::measured_around); an
   // image measured every pixel.
-  bool measured_around(const Sight& s, double tolerance, double dense_reach) const {
-    return !s.cell || cube_->measured_around(s.camera, s.cell->index, tolerance, dense_reach);
+  bool measured_around(const Sight& s, double voxel) const {
+    return !s.cell || cube_->measured_around(s.camera, s.cell->index, voxel);
   }
 
   // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
@@ -1182,7 +1182,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // vote beside surfaces it stood in for (vote_free_where_unvoted).
   if (lateral[1] > 0.0f && votes == VoteCounts(0) && surface[1] + surface[3] == 0.0f) {
     if (!seen_in_front()) {
-      if (!view.measured_around(sight, kRunsOnVoxels * config.global_voxel, config.global_voxel)) return false;
+      if (!view.measured_around(sight, config.global_voxel)) return false;
       const double weight = config.inverse_variance_fusion ? lateral[1] / config.variance_on_surface : lateral[1];
       out = {voxel, lateral[0] / lateral[1], static_cast<float>(weight), true};
       return true;
