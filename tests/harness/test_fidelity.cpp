@@ -254,8 +254,26 @@ std::vector<std::pair<std::string, MapperMaker>> mappers(Input input) {
   return list;
 }
 
+// The listener's raster origin at the head's pose (heading in degrees, as head_pose gives it).
+RasterOrigin origin_at(const Eigen::Isometry3d& camera, double heading_deg) {
+  RasterOrigin origin;
+  origin.position = camera.translation();
+  origin.heading = heading_deg * M_PI / 180.0;
+  return origin;
+}
+
+// The circle a map gives around `origin` (held by the rasteriser until its next reset).
+const Circle& circle_of(const Mapper& map, const RasterOrigin& origin, Rasteriser& rasteriser) {
+  std::vector<Eigen::Vector3f> samples;
+  map.surface_points(origin.position, rasteriser.config().max_range, samples);
+  rasteriser.reset(origin);
+  rasteriser.add(samples);
+  return rasteriser.circle();
+}
+
 // Runs every mapper through one room; adds each evaluated bin to the tallies (one per mapper).
-void run_room(const Room& room, Input input, std::vector<Tally>& tallies) {
+void run_room(uint64_t seed, Input input, std::vector<Tally>& tallies) {
+  const Room room = random_room(seed);
   const RasterConfig config;
   std::vector<std::unique_ptr<Mapper>> maps;
   for (const auto& m : mappers(input)) maps.push_back(m.second());
@@ -269,19 +287,14 @@ void run_room(const Room& room, Input input, std::vector<Tally>& tallies) {
     keep_input(input, frame);
     for (auto& map : maps) map->integrate(frame);
     if (i < 6 || i % 3 != 2) continue;  // evaluate every third frame once the map has a start
-    RasterOrigin origin;
-    origin.position = camera.translation();
-    origin.heading = heading * M_PI / 180.0;
+    const RasterOrigin origin = origin_at(camera, heading);
     std::vector<Box> boxes{scene.boxes.begin() + 1, scene.boxes.end()};  // not the floor
     const std::vector<eval::GroundTruthTriangle> triangles = triangles_of(boxes);
     const auto truth = eval::ground_truth_rasters(triangles, origin, config);
     const ResolvableTruth resolvable = resolvable_truth(triangles, truth.circle, origin, config);
     const auto old_place = eval::ground_truth_rasters(triangles_of({room.mover_before}), origin, config);
     for (size_t m = 0; m < maps.size(); ++m) {
-      std::vector<Eigen::Vector3f> samples;
-      maps[m]->surface_points(origin.position, config.max_range, samples);
-      rasteriser.reset(origin);
-      rasteriser.add(samples);
+      const Circle& circle = circle_of(*maps[m], origin, rasteriser);
       for (int b = 0; b < config.azimuth_bins; ++b) {
         const RasterCell& t = truth.circle.bins[b];
         if (!t.known()) continue;
@@ -293,7 +306,7 @@ void run_room(const Room& room, Input input, std::vector<Tally>& tallies) {
         std::array<bool, kClassCount> c = classify(*on, p, scene, camera);
         c[kVacated] = i >= kMoveFrame && !c[kOutOfView] && old_place.circle.bins[b].known() &&
                       old_place.circle.bins[b].range < t.range - kOff;
-        const RasterCell& r = rasteriser.circle().bins[b];
+        const RasterCell& r = circle.bins[b];
         const bool strict_far = !r.known() || r.range > t.range + kOff;
         const bool far = strict_far && std::isfinite(resolvable.farthest[b]) &&
                          (!r.known() || r.range > resolvable.farthest[b] + kOff);
@@ -339,7 +352,7 @@ void check_classes(std::initializer_list<int> classes, std::initializer_list<int
   const auto makers = mappers(input);
   std::vector<Tally> tallies(makers.size());
   const auto [first, last] = seed_range();
-  for (uint64_t seed = first; seed <= last; ++seed) run_room(random_room(seed), input, tallies);
+  for (uint64_t seed = first; seed <= last; ++seed) run_room(seed, input, tallies);
   std::ostringstream table;
   table << "| class | bins |";
   for (const auto& m : makers) table << ' ' << m.first << " off > 0.1 m (too far; strict; near) |";
@@ -435,9 +448,8 @@ TEST_CASE("Fidelity: from a dense cloud, a table whose corner stays just below t
   const Scene scene = scene_of(room.at(0));
   std::vector<Box> now;
   for (const Obstacle& o : room.at(0)) now.push_back(o.box);
-  const RasterConfig config;
   VdbGpdf map;
-  Rasteriser rasteriser(config);
+  Rasteriser rasteriser;
   double farthest_outside = 0.0;
   int readings = 0;
   for (int i = 0; i < kFrames; ++i) {
@@ -446,14 +458,7 @@ TEST_CASE("Fidelity: from a dense cloud, a table whose corner stays just below t
     Frame frame = test::render(scene, camera, i, kWidth, kHeight, 5.0, true);
     keep_input(Input::kCloud, frame);
     map.integrate(frame);
-    RasterOrigin origin;
-    origin.position = camera.translation();
-    origin.heading = heading * M_PI / 180.0;
-    std::vector<Eigen::Vector3f> samples;
-    map.surface_points(origin.position, config.max_range, samples);
-    rasteriser.reset(origin);
-    rasteriser.add(samples);
-    for (const RasterCell& r : rasteriser.circle().bins) {
+    for (const RasterCell& r : circle_of(map, origin_at(camera, heading), rasteriser).bins) {
       if (!r.known()) continue;
       const Eigen::Vector3d p = r.point.cast<double>();
       double outside = HUGE_VAL;  // across the floor, to the nearest box's footprint (walls included)
