@@ -61,9 +61,14 @@ constexpr double kNewSurfaceVoxels = 0.5;
 // 16 readings too near (11 with the cap), and on the smoke scene a box's corner ran 8 mm into
 // the next bin.
 constexpr double kInsideCapVoxels = 0.5;
-// The widest spacing of a lidar's rings that a ring's neighbourhood (surface_normal) and a
-// lateral vote (CubeRangeImage::measured_around) bridge.
+// The widest spacing of a lidar's rings that a ring's neighbourhood (surface_normal), the search
+// for the next rings (CubeRangeImage::next_rings) and a lateral vote (CubeRangeImage::measured_around)
+// bridge.
 constexpr double kRingSpacingDeg = 3.0;
+// A ring's line within this many voxels of the plane of the next two rings on one side lies on
+// that surface (LeafQueries::plane_to_next_rings): 2 cm at 5 cm, half of a 4 cm table top's
+// front face, whose lower half a ring must not take for the top.
+constexpr double kOnRingPlaneVoxels = 0.4;
 // A lateral vote beyond what a cloud measured (the sensor's field of view ends there) stands
 // only where a measured surface within kRingSpacingDeg lies within this many voxels of its
 // range: the surface ran on up to the view's edge. At 2 voxels (in a first form of the rule,
@@ -109,14 +114,18 @@ class CubeRangeImage {
  public:
   static constexpr int kCubeCells = 360;
 
-  explicit CubeRangeImage(const std::vector<Eigen::Vector3f>& points) : depth_(6 * kCubeCells * kCubeCells, 0.0f) {
+  explicit CubeRangeImage(const std::vector<Eigen::Vector3f>& points)
+      : points_(points), depth_(6 * kCubeCells * kCubeCells, 0.0f), nearest_(depth_.size(), -1) {
     std::vector<int> cells;
     cells.reserve(points.size());
-    for (const Eigen::Vector3f& p : points) {
-      const std::optional<Cell> c = cell_of(p.cast<double>());
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::optional<Cell> c = cell_of(points[i].cast<double>());
       if (!c) continue;
       float& d = depth_[c->index];
-      if (d == 0.0f || c->depth < d) d = static_cast<float>(c->depth);
+      if (d == 0.0f || c->depth < d) {
+        d = static_cast<float>(c->depth);
+        nearest_[c->index] = static_cast<int>(i);
+      }
       cells.push_back(c->index);
     }
     // Dense: most measured cells have another within two cells along both axes of their face
@@ -199,6 +208,28 @@ class CubeRangeImage {
     return runs_on && (!dense_ || nearest_step * kStepTangent * range <= voxel);
   }
 
+  // The nearest points the cloud measured on the next two rings on one side (`side`: +1 or -1)
+  // of a ring's line through camera-frame point c, across the line's image: past c's own ring
+  // (the cells measured around c), the first measured cell within kRingSpacingDeg, and past
+  // that ring the first within twice that (none where nothing was measured).
+  struct NextRings {
+    std::optional<Eigen::Vector3d> first, second;
+  };
+  NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side) const {
+    NextRings rings;
+    const Eigen::Vector3d d = c.normalized();
+    const Eigen::Vector3d across = d.cross(line);  // in the image, across the line's image
+    if (!(across.norm() > 1e-6)) return rings;  // the line runs along the line of sight
+    const Eigen::Vector3d axis = side * across.normalized();
+    const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
+    const std::optional<Measured> first = first_measured(d, axis, true, 1, steps);
+    if (!first) return rings;
+    rings.first = points_[static_cast<size_t>(nearest_[static_cast<size_t>(first->index)])].cast<double>();
+    const std::optional<Measured> second = first_measured(d, axis, true, first->step + 1, 2 * steps);
+    if (second) rings.second = points_[static_cast<size_t>(nearest_[static_cast<size_t>(second->index)])].cast<double>();
+    return rings;
+  }
+
   // The camera-frame point at `depth` along the centre of cell `index`.
   static Eigen::Vector3d point(int index, double depth) {
     const int u = index % kCubeCells, v = (index / kCubeCells) % kCubeCells, face = index / (kCubeCells * kCubeCells);
@@ -214,17 +245,27 @@ class CubeRangeImage {
   struct Measured {
     int step;  // of kStepDeg
     double range;
+    int index;  // the cell's
   };
   // The first measured cell from unit direction d turning toward `axis`, in steps finer than
-  // the cells at a face's edge, up to kRingSpacingDeg (none: nothing measured).
-  std::optional<Measured> first_measured(const Eigen::Vector3d& d, const Eigen::Vector3d& axis) const {
-    const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
-    for (int k = 1; k <= steps; ++k) {
+  // the cells at a face's edge, from step `first` to `last` (by default up to kRingSpacingDeg;
+  // none: nothing measured); with `past_ring`, the first after an empty one (the ring measured
+  // where the walk starts is passed).
+  std::optional<Measured> first_measured(const Eigen::Vector3d& d, const Eigen::Vector3d& axis, bool past_ring = false,
+                                         int first = 1, int last = -1) const {
+    if (last < 0) last = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
+    bool past = !past_ring;
+    for (int k = first; k <= last; ++k) {
       const Eigen::Vector3d q = d + (k * kStepTangent) * axis;
       const std::optional<Cell> c = cell_of(q);
-      if (!c || !(depth_[static_cast<size_t>(c->index)] > 0.0f)) continue;
+      if (!c) continue;
+      if (!(depth_[static_cast<size_t>(c->index)] > 0.0f)) {
+        past = true;
+        continue;
+      }
+      if (!past) continue;
       const int face_axis = c->index / (kCubeCells * kCubeCells) / 2;
-      return Measured{k, depth_[static_cast<size_t>(c->index)] * q.norm() / std::abs(q[face_axis])};
+      return Measured{k, depth_[static_cast<size_t>(c->index)] * q.norm() / std::abs(q[face_axis]), c->index};
     }
     return std::nullopt;
   }
@@ -249,7 +290,9 @@ class CubeRangeImage {
   static constexpr double kStepDeg = 0.15;  // finer than a cell at a face's edge (0.16 degree)
   static inline const double kStepTangent = std::tan(kStepDeg * M_PI / 180.0);
 
+  const std::vector<Eigen::Vector3f>& points_;
   std::vector<float> depth_;
+  std::vector<int> nearest_;  // per cell, the index of its nearest point (-1: none)
   bool dense_ = false;  // a depth camera's cloud, not a lidar's rings (the constructor)
 };
 
@@ -310,6 +353,17 @@ class DepthView {
     const double inset = std::min(std::min(p->x() + 0.5, frame_.width - 0.5 - p->x()),
                                   std::min(p->y() + 0.5, frame_.height - 0.5 - p->y()));
     return inset < pixels;
+  }
+
+  // For a cloud, the world points of the next two rings on one side of a ring's world-frame
+  // line through `world` (CubeRangeImage::next_rings); none for an image.
+  CubeRangeImage::NextRings next_rings(const Eigen::Vector3d& world, const Eigen::Vector3d& line, double side) const {
+    CubeRangeImage::NextRings rings;
+    if (!cube_) return rings;
+    rings = cube_->next_rings(camera_T_world_ * world, camera_T_world_.linear() * line, side);
+    for (std::optional<Eigen::Vector3d>* m : {&rings.first, &rings.second})
+      if (*m) *m = frame_.world_T_camera * **m;
+    return rings;
   }
 
   // For a cloud, whether it measured around the point (CubeRangeImage::measured_around); an
@@ -547,10 +601,12 @@ struct Scatter {
 };
 
 // A plane through the scatter: its normal facing u (zero when the points are too few for a
-// plane), and whether they lie along a line, for which any plane through it fits as well.
+// plane), and whether they lie along a line, for which any plane through it fits as well, and
+// the direction of their widest spread (the line's, if they lie along one).
 struct PlaneFit {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   bool line = false;
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();
 };
 constexpr double kLineSpread = 0.2;  // second eigenvalue below this share of the largest: a line
 PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
@@ -563,7 +619,8 @@ PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
   Eigen::Vector3d n = eig.eigenvectors().col(0);  // smallest eigenvalue first
   if (eig.info() != Eigen::Success || !n.allFinite()) return {};
   n.normalize();
-  return {n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n, eig.eigenvalues()[1] < kLineSpread * eig.eigenvalues()[2]};
+  return {n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n, eig.eigenvalues()[1] < kLineSpread * eig.eigenvalues()[2],
+          eig.eigenvectors().col(2).normalized()};
 }
 
 // The local voxels' centroids of a local leaf and its neighbours within `reach` of p: where a
@@ -593,14 +650,15 @@ struct WideNeighbourhood {
 // plane). Returns zero where the neighbourhood is too small for a plane. In a cloud (`wide`
 // given), a neighbourhood along a line, as a lidar's ring crosses a surface, fits any plane
 // through the line: it is widened to `wide_reach` to take in the next ring, and where that
-// still holds a line only, the normal is zero too. From the ball alone, the random box rooms
-// from rings one image row each read too far at 37 corner bins of 410, 52 low and 106 thin
-// (docs/fidelity.md, "Rings one row each").
+// still holds a line only, the normal is zero too and `ring` gets the line's direction. From the
+// ball alone, the random box rooms from rings one image row each read too far at 37 corner bins
+// of 410, 52 low and 106 thin (docs/fidelity.md, "Rings one row each").
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
 // object, and front points land inside it: measured 13 cm deep in a box.)
 Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c, const Eigen::Vector3d& p,
-                               const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach) {
+                               const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach,
+                               Eigen::Vector3d* ring) {
   Scatter ball;
   static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
   for (const auto& [dx, dy, dz] : kBall) {
@@ -610,7 +668,9 @@ Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::
   const PlaneFit fit = fit_plane(ball, u);
   if (!fit.line || !wide) return fit.normal;
   const PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
-  return widened.line ? Eigen::Vector3d::Zero() : widened.normal;
+  if (!widened.line) return widened.normal;
+  *ring = widened.along;
+  return Eigen::Vector3d::Zero();
 }
 
 // What one query point or carving ray says of the global voxel it falls in. The value itself
@@ -892,9 +952,9 @@ void train_local_gps(const GpParams& params, LocalFrame& local) {
 class LeafQueries {
  public:
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
-              size_t leaf, const Eigen::Vector3d& origin, bool lateral)
-      : config_(config), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
-        lateral_(lateral), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index),
+              size_t leaf, const Eigen::Vector3d& origin, const DepthView& view)
+      : config_(config), view_(view), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
+        lateral_(!view.has_image()), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index),
         wide_{local.cells, local.gps, leaf} {}
 
   std::vector<Vote> votes;
@@ -905,8 +965,10 @@ class LeafQueries {
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const openvdb::Coord c = voxel_of(p, config_.local_voxel);
-    const Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
-                                                  lateral_ ? &wide_ : nullptr, ring_reach(range));
+    Eigen::Vector3d ring = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
+                                            lateral_ ? &wide_ : nullptr, ring_reach(range), &ring);
+    if (normal.isZero() && !ring.isZero()) normal = plane_to_next_rings(p, u, ring);
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
@@ -932,6 +994,48 @@ class LeafQueries {
   double ring_reach(double range) const {
     return std::clamp(std::tan(kRingSpacingDeg * M_PI / 180.0) * range, (kNormalReach + 1) * config_.local_voxel,
                       LeafCells::Leaf::DIM * config_.local_voxel);
+  }
+
+  // A ring whose neighbourhood, even widened, holds its own line only: the surface is seen at a
+  // grazing angle, and the next rings cross it farther away than the widened reach (rings 2.3
+  // degrees apart cross a table top 0.8 m below the eye and 2 m ahead 25 cm apart). Without a
+  // normal a source casts no lateral vote, the top held voxels on its rings only, and its edges
+  // read up to a ring's spacing too far (rooms 13-24 of docs/fidelity.md: 125 thin-slab bins,
+  // the TSDF peer 24). The normal is then the plane's through the line and the nearest point of
+  // a next ring, where the rings show the surface going on: the next rings on both sides lie on
+  // that plane within a voxel (between two rings of one surface), or the line lies within
+  // kOnRingPlaneVoxels of the plane of the next two rings on one side (a surface's first or
+  // last ring). Else it stays zero. The nearest ring alone was not enough: a level lidar's ring
+  // on a counter top's 4 cm front face took the top's plane, which put the face's voxels above
+  // it in free space, and the top's first 18 cm left the circle (tests/core, "a counter top 4 cm
+  // thick").
+  Eigen::Vector3d plane_to_next_rings(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
+                                      const Eigen::Vector3d& line) const {
+    const CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0), above = view_.next_rings(p, line, 1.0);
+    auto plane_normal = [&](const Eigen::Vector3d& along) -> std::optional<Eigen::Vector3d> {
+      const Eigen::Vector3d n = line.cross(along);
+      if (!(n.norm() > 1e-9)) return std::nullopt;
+      return n.normalized();
+    };
+    std::optional<Eigen::Vector3d> next;  // the point the plane passes through
+    if (below.first && above.first) {
+      const bool below_nearer = (*below.first - p).squaredNorm() < (*above.first - p).squaredNorm();
+      const Eigen::Vector3d& nearer = below_nearer ? *below.first : *above.first;
+      const Eigen::Vector3d& farther = below_nearer ? *above.first : *below.first;
+      const std::optional<Eigen::Vector3d> n = plane_normal(nearer - p);
+      if (n && std::abs(n->dot(farther - p)) <= vg_) next = nearer;
+    }
+    if (!next)
+      for (const CubeRangeImage::NextRings* side : {&below, &above}) {
+        if (!side->first || !side->second) continue;
+        const std::optional<Eigen::Vector3d> n = plane_normal(*side->second - *side->first);
+        if (!n || !(std::abs(n->dot(p - *side->first)) <= kOnRingPlaneVoxels * vg_)) continue;
+        if (!next || (*side->first - p).squaredNorm() < (*next - p).squaredNorm()) next = side->first;
+      }
+    if (!next) return Eigen::Vector3d::Zero();
+    const std::optional<Eigen::Vector3d> n = plane_normal(*next - p);
+    if (!n) return Eigen::Vector3d::Zero();
+    return n->dot(u) < 0.0 ? Eigen::Vector3d(-*n) : *n;
   }
 
   // Appends a vote field by field (as append_run: no Vote built on the stack and copied).
@@ -1022,6 +1126,7 @@ class LeafQueries {
   }
 
   const VdbGpdfConfig& config_;
+  const DepthView& view_;
   const SurfaceGp& gp_;
   Eigen::Vector3d origin_;
   double vg_;
@@ -1257,7 +1362,7 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   const size_t leaves = local.sources.size();
   std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
-    LeafQueries queries(config, local, fused, leaf, origin, !view.has_image());
+    LeafQueries queries(config, local, fused, leaf, origin, view);
     queries.votes.reserve(local.sources[leaf].size() * kVotesPerSource);
     for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
     votes[leaf] = std::move(queries.votes);
