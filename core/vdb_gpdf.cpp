@@ -224,9 +224,9 @@ class CubeRangeImage {
     const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
     const std::optional<Measured> first = first_measured(d, axis, true, 1, steps);
     if (!first) return rings;
-    rings.first = points_[static_cast<size_t>(nearest_[static_cast<size_t>(first->index)])].cast<double>();
+    rings.first = point_of(*first);
     const std::optional<Measured> second = first_measured(d, axis, true, first->step + 1, 2 * steps);
-    if (second) rings.second = points_[static_cast<size_t>(nearest_[static_cast<size_t>(second->index)])].cast<double>();
+    if (second) rings.second = point_of(*second);
     return rings;
   }
 
@@ -247,6 +247,11 @@ class CubeRangeImage {
     double range;
     int index;  // the cell's
   };
+  // The nearest point the cloud measured in a measured cell.
+  Eigen::Vector3d point_of(const Measured& m) const {
+    return points_[static_cast<size_t>(nearest_[static_cast<size_t>(m.index)])].cast<double>();
+  }
+
   // The first measured cell from unit direction d turning toward `axis`, in steps finer than
   // the cells at a face's edge, from step `first` to `last` (by default up to kRingSpacingDeg;
   // none: nothing measured); with `past_ring`, the first after an empty one (the ring measured
@@ -1006,9 +1011,9 @@ class LeafQueries {
   // that plane within a voxel (between two rings of one surface), or the line lies within
   // kOnRingPlaneVoxels of the plane of the next two rings on one side (a surface's first or
   // last ring). Else it stays zero. The nearest ring alone was not enough: a level lidar's ring
-  // on a counter top's 4 cm front face took the top's plane, which put the face's voxels above
-  // it in free space, and the top's first 18 cm left the circle (tests/core, "a counter top 4 cm
-  // thick").
+  // on a counter top's 4 cm front face took the top's plane, whose offsets put the top's first
+  // layer of voxels on the free side, and the circle read the top's front edge up to 0.18 m too
+  // far (tests/core, "a counter top 4 cm thick").
   Eigen::Vector3d plane_to_next_rings(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
                                       const Eigen::Vector3d& line) const {
     const CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0), above = view_.next_rings(p, line, 1.0);

@@ -515,7 +515,7 @@ TEST_CASE("Fidelity: from a lidar's rings 25 cm apart across a table top, fewer 
     return b.lo.x() > 1.52 && b.hi.x() < 2.83 && b.lo.y() > -1.97 && b.hi.y() < -1.01 && b.hi.z() < 0.78;
   }, 4 + 5);
   const std::vector<eval::GroundTruthTriangle> triangles = triangles_of(boxes_of(room.at(0)));
-  const Obstacle top = room.obstacles[4];
+  const Obstacle top = room.obstacles[4];  // after the 4 walls: random_room adds a top before its legs
   const Scene scene = scene_of(room.at(0));
   int on_top = 0, too_far = 0;
   VdbGpdf map;
@@ -535,7 +535,8 @@ TEST_CASE("Fidelity: from a lidar's rings 25 cm apart across a table top, fewer 
       too_far += !r.known() || r.range > resolvable.farthest[b] + kOff;
     }
   });
-  INFO(on_top << " bins in view on the table top in frames 6-23, " << too_far << " of them read more than 0.1 m too far");
+  INFO(on_top << " bins in view on the table top in frames 6-23, " << too_far
+              << " of them read more than 0.1 m too far");
   CHECK(on_top > 100);
   CHECK(6 * too_far < on_top);
 }
