@@ -208,24 +208,25 @@ class CubeRangeImage {
     return runs_on && (!dense_ || nearest_step * kStepTangent * range <= voxel);
   }
 
-  // The nearest points the cloud measured on the next two rings on one side (`side`: +1 or -1)
-  // of a ring's line through camera-frame point c, across the line's image: past c's own ring
-  // (the cells measured around c), the first measured cell within kRingSpacingDeg, and past
-  // that ring the first within twice that (none where nothing was measured).
+  // The nearest points the cloud measured on the next ring, or the next two (`two`), on one
+  // side (`side`: +1 or -1) of a ring's line through camera-frame point c, across the line's
+  // image: past c's own ring (the cells measured around c), the first measured cell within
+  // kRingSpacingDeg, and past that ring the first within twice that (none where nothing was
+  // measured).
   struct NextRings {
     std::optional<Eigen::Vector3d> first, second;
   };
-  NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side) const {
+  NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side, bool two) const {
     NextRings rings;
     const Eigen::Vector3d d = c.normalized();
     const Eigen::Vector3d across = d.cross(line);  // in the image, across the line's image
     if (!(across.norm() > 1e-6)) return rings;  // the line runs along the line of sight
     const Eigen::Vector3d axis = side * across.normalized();
-    const int steps = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
-    const std::optional<Measured> first = first_measured(d, axis, true, 1, steps);
+    const std::optional<Measured> first = first_measured(d, axis, true);
     if (!first) return rings;
     rings.first = point_of(*first);
-    const std::optional<Measured> second = first_measured(d, axis, true, first->step + 1, 2 * steps);
+    if (!two) return rings;
+    const std::optional<Measured> second = first_measured(d, axis, true, first->step + 1, 2 * kRingSteps);
     if (second) rings.second = point_of(*second);
     return rings;
   }
@@ -257,8 +258,7 @@ class CubeRangeImage {
   // none: nothing measured); with `past_ring`, the first after an empty one (the ring measured
   // where the walk starts is passed).
   std::optional<Measured> first_measured(const Eigen::Vector3d& d, const Eigen::Vector3d& axis, bool past_ring = false,
-                                         int first = 1, int last = -1) const {
-    if (last < 0) last = static_cast<int>(std::lround(kRingSpacingDeg / kStepDeg));
+                                         int first = 1, int last = kRingSteps) const {
     bool past = !past_ring;
     for (int k = first; k <= last; ++k) {
       const Eigen::Vector3d q = d + (k * kStepTangent) * axis;
@@ -292,7 +292,8 @@ class CubeRangeImage {
     return std::clamp(static_cast<int>(std::floor((t + 1.0) * 0.5 * kCubeCells)), 0, kCubeCells - 1);
   }
 
-  static constexpr double kStepDeg = 0.15;  // finer than a cell at a face's edge (0.16 degree)
+  static constexpr int kRingSteps = 20;  // the steps of a walk across kRingSpacingDeg
+  static constexpr double kStepDeg = kRingSpacingDeg / kRingSteps;  // 0.15: finer than a cell at a face's edge (0.16)
   static inline const double kStepTangent = std::tan(kStepDeg * M_PI / 180.0);
 
   const std::vector<Eigen::Vector3f>& points_;
@@ -360,12 +361,13 @@ class DepthView {
     return inset < pixels;
   }
 
-  // For a cloud, the world points of the next two rings on one side of a ring's world-frame
+  // For a cloud, the world points of the next ring (or two) on one side of a ring's world-frame
   // line through `world` (CubeRangeImage::next_rings); none for an image.
-  CubeRangeImage::NextRings next_rings(const Eigen::Vector3d& world, const Eigen::Vector3d& line, double side) const {
+  CubeRangeImage::NextRings next_rings(const Eigen::Vector3d& world, const Eigen::Vector3d& line, double side,
+                                       bool two) const {
     CubeRangeImage::NextRings rings;
     if (!cube_) return rings;
-    rings = cube_->next_rings(camera_T_world_ * world, camera_T_world_.linear() * line, side);
+    rings = cube_->next_rings(camera_T_world_ * world, camera_T_world_.linear() * line, side, two);
     for (std::optional<Eigen::Vector3d>* m : {&rings.first, &rings.second})
       if (*m) *m = frame_.world_T_camera * **m;
     return rings;
@@ -652,18 +654,18 @@ struct WideNeighbourhood {
 
 // The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
 // centroids of the occupied local voxels within two voxels of p's (up to 57, about 25 on a
-// plane). Returns zero where the neighbourhood is too small for a plane. In a cloud (`wide`
-// given), a neighbourhood along a line, as a lidar's ring crosses a surface, fits any plane
-// through the line: it is widened to `wide_reach` to take in the next ring, and where that
-// still holds a line only, the normal is zero too and `ring` gets the line's direction. From the
-// ball alone, the random box rooms from rings one image row each read too far at 37 corner bins
-// of 410, 52 low and 106 thin (docs/fidelity.md, "Rings one row each").
+// plane). The normal is zero where the neighbourhood is too small for a plane. In a cloud
+// (`wide` given), a neighbourhood along a line, as a lidar's ring crosses a surface, fits any
+// plane through the line: it is widened to `wide_reach` to take in the next ring, and where
+// that still holds a line only, the normal is zero too, `line` is set and `along` is the
+// line's direction (elsewhere `line` is false). From the ball alone, the random box rooms from
+// rings one image row each read too far at 37 corner bins of 410, 52 low and 106 thin
+// (docs/fidelity.md, "Rings one row each").
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
 // object, and front points land inside it: measured 13 cm deep in a box.)
-Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c, const Eigen::Vector3d& p,
-                               const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach,
-                               Eigen::Vector3d* ring) {
+PlaneFit surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c, const Eigen::Vector3d& p,
+                        const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach) {
   Scatter ball;
   static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
   for (const auto& [dx, dy, dz] : kBall) {
@@ -671,11 +673,10 @@ Eigen::Vector3d surface_normal(const NormalNeighbourhood& local, const openvdb::
     if (at) ball.add(*at - p);
   }
   const PlaneFit fit = fit_plane(ball, u);
-  if (!fit.line || !wide) return fit.normal;
-  const PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
-  if (!widened.line) return widened.normal;
-  *ring = widened.along;
-  return Eigen::Vector3d::Zero();
+  if (!fit.line || !wide) return {fit.normal};
+  PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
+  if (widened.line) widened.normal.setZero();
+  return widened;
 }
 
 // What one query point or carving ray says of the global voxel it falls in. The value itself
@@ -970,10 +971,9 @@ class LeafQueries {
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const openvdb::Coord c = voxel_of(p, config_.local_voxel);
-    Eigen::Vector3d ring = Eigen::Vector3d::Zero();
-    Eigen::Vector3d normal = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
-                                            lateral_ ? &wide_ : nullptr, ring_reach(range), &ring);
-    if (normal.isZero() && !ring.isZero()) normal = plane_to_next_rings(p, u, ring);
+    const PlaneFit fit = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
+                                        lateral_ ? &wide_ : nullptr, ring_reach(range));
+    const Eigen::Vector3d normal = fit.line ? plane_to_next_rings(p, u, fit.along) : fit.normal;
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
@@ -1016,31 +1016,46 @@ class LeafQueries {
   // far (tests/core, "a counter top 4 cm thick").
   Eigen::Vector3d plane_to_next_rings(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
                                       const Eigen::Vector3d& line) const {
-    const CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0), above = view_.next_rings(p, line, 1.0);
-    auto plane_normal = [&](const Eigen::Vector3d& along) -> std::optional<Eigen::Vector3d> {
-      const Eigen::Vector3d n = line.cross(along);
-      if (!(n.norm() > 1e-9)) return std::nullopt;
-      return n.normalized();
-    };
-    std::optional<Eigen::Vector3d> next;  // the point the plane passes through
-    if (below.first && above.first) {
-      const bool below_nearer = (*below.first - p).squaredNorm() < (*above.first - p).squaredNorm();
-      const Eigen::Vector3d& nearer = below_nearer ? *below.first : *above.first;
-      const Eigen::Vector3d& farther = below_nearer ? *above.first : *below.first;
-      const std::optional<Eigen::Vector3d> n = plane_normal(nearer - p);
-      if (n && std::abs(n->dot(farther - p)) <= vg_) next = nearer;
-    }
-    if (!next)
-      for (const CubeRangeImage::NextRings* side : {&below, &above}) {
-        if (!side->first || !side->second) continue;
-        const std::optional<Eigen::Vector3d> n = plane_normal(*side->second - *side->first);
-        if (!n || !(std::abs(n->dot(p - *side->first)) <= kOnRingPlaneVoxels * vg_)) continue;
-        if (!next || (*side->first - p).squaredNorm() < (*next - p).squaredNorm()) next = side->first;
-      }
-    if (!next) return Eigen::Vector3d::Zero();
-    const std::optional<Eigen::Vector3d> n = plane_normal(*next - p);
+    std::optional<Eigen::Vector3d> next = next_ring_between(p, line);  // the point the plane passes through
+    if (!next) next = next_ring_on_one_side(p, line);
+    const std::optional<Eigen::Vector3d> n = next ? plane_normal(line, *next - p) : std::nullopt;
     if (!n) return Eigen::Vector3d::Zero();
     return n->dot(u) < 0.0 ? Eigen::Vector3d(-*n) : *n;
+  }
+
+  // The unit normal of the plane spanned by a line and a direction (none: they are parallel).
+  static std::optional<Eigen::Vector3d> plane_normal(const Eigen::Vector3d& line, const Eigen::Vector3d& along) {
+    const Eigen::Vector3d n = line.cross(along);
+    if (!(n.norm() > 1e-9)) return std::nullopt;
+    return n.normalized();
+  }
+
+  // Between two rings of one surface: the nearer of the next rings on either side, where the
+  // plane through it and the line passes within a voxel of the other.
+  std::optional<Eigen::Vector3d> next_ring_between(const Eigen::Vector3d& p, const Eigen::Vector3d& line) const {
+    const CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0, false);
+    const CubeRangeImage::NextRings above = view_.next_rings(p, line, 1.0, false);
+    if (!below.first || !above.first) return std::nullopt;
+    const bool below_nearer = (*below.first - p).squaredNorm() < (*above.first - p).squaredNorm();
+    const Eigen::Vector3d& nearer = below_nearer ? *below.first : *above.first;
+    const Eigen::Vector3d& farther = below_nearer ? *above.first : *below.first;
+    const std::optional<Eigen::Vector3d> n = plane_normal(line, nearer - p);
+    if (!n || !(std::abs(n->dot(farther - p)) <= vg_)) return std::nullopt;
+    return nearer;
+  }
+
+  // A surface's first or last ring: the nearer next ring of a side whose next two rings span a
+  // plane that the line lies on, within kOnRingPlaneVoxels.
+  std::optional<Eigen::Vector3d> next_ring_on_one_side(const Eigen::Vector3d& p, const Eigen::Vector3d& line) const {
+    std::optional<Eigen::Vector3d> next;
+    for (double side : {-1.0, 1.0}) {
+      const CubeRangeImage::NextRings rings = view_.next_rings(p, line, side, true);
+      if (!rings.first || !rings.second) continue;
+      const std::optional<Eigen::Vector3d> n = plane_normal(line, *rings.second - *rings.first);
+      if (!n || !(std::abs(n->dot(p - *rings.first)) <= kOnRingPlaneVoxels * vg_)) continue;
+      if (!next || (*rings.first - p).squaredNorm() < (*next - p).squaredNorm()) next = rings.first;
+    }
+    return next;
   }
 
   // Appends a vote field by field (as append_run: no Vote built on the stack and copied).
