@@ -197,8 +197,9 @@ class CubeRangeImage {
       return true;
     };
     const bool a_up = measured_along(a), a_down = measured_along(-a);
+    if (a_up && a_down) return true;
     const bool b_up = measured_along(b), b_down = measured_along(-b);
-    if ((a_up && a_down) || (b_up && b_down)) return true;
+    if (b_up && b_down) return true;
     for (const Eigen::Vector3d& diagonal : {Eigen::Vector3d((a + b).normalized()), Eigen::Vector3d((a - b).normalized())}) {
       measured_along(diagonal);
       measured_along(-diagonal);
@@ -536,6 +537,7 @@ struct LeafCells {
     openvdb::Coord global;
   };
   std::vector<Cell> cells;
+  Eigen::AlignedBox3d box;  // of the cells' centroids
   std::vector<openvdb::Coord> trained;
   std::array<int16_t, Leaf::SIZE> cell_of{};  // 1 kB a leaf: no bit counting per probe
 };
@@ -616,8 +618,9 @@ struct PlaneFit {
   Eigen::Vector3d along = Eigen::Vector3d::Zero();
 };
 constexpr double kLineSpread = 0.2;  // second eigenvalue below this share of the largest: a line
+constexpr int kMinPlanePoints = 5;
 PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
-  if (s.count < 5) return {};
+  if (s.count < kMinPlanePoints) return {};
   const Eigen::Vector3d mean = Eigen::Vector3d(s.sx, s.sy, s.sz) / s.count;
   Eigen::Matrix3d outer;
   outer << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
@@ -635,14 +638,13 @@ PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
 // (2 degrees on: 7 cm at 2 m) shows which plane through the ring is the surface.
 struct WideNeighbourhood {
   const std::vector<LeafCells>& cells;
-  const LocalGps& leaves;  // their centres and neighbours
+  const LocalGps& leaves;  // their neighbours
   size_t leaf;
   Scatter around(const Eigen::Vector3d& p, double reach) const {
     Scatter s;
-    const double half = kLeafDim * 0.5 * leaves.voxel;
     auto add_leaf = [&](size_t i) {
-      const Eigen::Vector3d outside = ((leaves.centres[i] - p).cwiseAbs().array() - half).cwiseMax(0.0);
-      if (outside.squaredNorm() > reach * reach) return;  // the leaf lies out of reach
+      // A ring's leaf holds a line of cells: their box, not the leaf's, rules most leaves out.
+      if (cells[i].box.squaredExteriorDistance(p) > reach * reach) return;  // out of reach
       for (const auto& cell : cells[i].cells)
         if ((cell.centroid - p).squaredNorm() <= reach * reach) s.add(cell.centroid - p);
     };
@@ -652,15 +654,31 @@ struct WideNeighbourhood {
   }
 };
 
+// Whether a fit is what one ring's points give: a line, or a plane that the line of sight runs
+// along (within kMinNormalDotRay), the ring's own scan plane through the sensor. A ring lies in
+// that plane whatever the surface, and a depth camera's quantised depth spreads an image row's
+// points across it in steps 1.4 cm high on a slab 3 m away. That plane's normal lies at right
+// angles to the ray with either sign: sources on room 17's slab took normals 17 degrees off
+// the vertical pointing down into the slab, and its top, seen by rings 35 cm apart, held
+// surface near one ring only (docs/fidelity.md, "A ring's own scan plane").
+bool of_one_ring(const PlaneFit& fit, const Eigen::Vector3d& u) {
+  return fit.line || (!fit.normal.isZero() && !(fit.normal.dot(u) > kMinNormalDotRay));
+}
+
 // The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the
 // centroids of the occupied local voxels within two voxels of p's (up to 57, about 25 on a
 // plane). The normal is zero where the neighbourhood is too small for a plane. In a cloud
-// (`wide` given), a neighbourhood along a line, as a lidar's ring crosses a surface, fits any
-// plane through the line: it is widened to `wide_reach` to take in the next ring, and where
-// that still holds a line only, the normal is zero too, `line` is set and `along` is the
-// line's direction (elsewhere `line` is false). From the ball alone, the random box rooms from
-// rings one image row each read too far at 37 corner bins of 410, 52 low and 106 thin
-// (docs/fidelity.md, "Rings one row each").
+// (`wide` given), a neighbourhood of one ring (of_one_ring), as a lidar's ring crosses a
+// surface, fits any plane through the ring: it is widened to `wide_reach` to take in the next
+// ring, and where that still holds one ring only, the normal is zero too, `line` is set and
+// `along` is the ring's direction (elsewhere `line` is false). So is a ball with too few points
+// for a plane (a short step of a ring's staircase, a ring's end), but there only the next
+// rings may give the normal: a plane fitted to the widened neighbourhood took in other surfaces
+// around a ring's end (rooms 1-12 from rings: 6 to 12 more bins too near at low boxes, thin
+// slabs and grazing faces, for one fewer too far at corners and thin slabs; docs/fidelity.md,
+// "A ring's own scan plane"). From the ball alone, the random box rooms from rings one image
+// row each read too far at 37 corner bins of 410, 52 low and 106 thin (docs/fidelity.md,
+// "Rings one row each").
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
 // object, and front points land inside it: measured 13 cm deep in a box.)
@@ -673,9 +691,11 @@ PlaneFit surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& 
     if (at) ball.add(*at - p);
   }
   const PlaneFit fit = fit_plane(ball, u);
-  if (!fit.line || !wide) return {fit.normal};
-  PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
-  if (widened.line) widened.normal.setZero();
+  const bool too_few = ball.count < kMinPlanePoints;
+  if (!wide || !(too_few || of_one_ring(fit, u))) return {fit.normal};
+  const PlaneFit widened = fit_plane(wide->around(p, wide_reach), u);
+  if (of_one_ring(widened, u)) return {Eigen::Vector3d::Zero(), true, widened.along};
+  if (too_few) return {};
   return widened;
 }
 
@@ -869,6 +889,7 @@ void index_local_leaves(const VdbGpdfConfig& config, bool cloud, LocalFrame& out
       const Eigen::Vector3d c = centroid(*v);
       cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
+      cells[i].box.extend(c);
       if (k % stride != 0) continue;
       out.training[i].push_back(c.cast<float>());
       cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
