@@ -537,7 +537,7 @@ struct LeafCells {
     openvdb::Coord global;
   };
   std::vector<Cell> cells;
-  Eigen::AlignedBox3d box;  // of the cells' centroids
+  Eigen::AlignedBox3d box;  // of the cells' centroids, in a cloud's frame (empty in an image's)
   std::vector<openvdb::Coord> trained;
   std::array<int16_t, Leaf::SIZE> cell_of{};  // 1 kB a leaf: no bit counting per probe
 };
@@ -889,7 +889,7 @@ void index_local_leaves(const VdbGpdfConfig& config, bool cloud, LocalFrame& out
       const Eigen::Vector3d c = centroid(*v);
       cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
-      cells[i].box.extend(c);
+      if (cloud) cells[i].box.extend(c);  // for WideNeighbourhood, clouds only
       if (k % stride != 0) continue;
       out.training[i].push_back(c.cast<float>());
       cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
