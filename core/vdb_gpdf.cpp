@@ -209,27 +209,33 @@ class CubeRangeImage {
     return runs_on && (!dense_ || nearest_step * kStepTangent * range <= voxel);
   }
 
-  // The nearest points the cloud measured on the next ring, or the next two (`two`), on one
-  // side (`side`: +1 or -1) of a ring's line through camera-frame point c, across the line's
-  // image: past c's own ring (the cells measured around c), the first measured cell within
-  // kRingSpacingDeg, and past that ring the first within twice that (none where nothing was
-  // measured).
+  // The nearest points the cloud measured on the next ring, and on request the one after, on
+  // one side (`side`: +1 or -1) of a ring's line through camera-frame point c, across the
+  // line's image: past c's own ring (the cells measured around c), the first measured cell
+  // within kRingSpacingDeg (next_rings), and past that ring the first within twice that
+  // (add_second_ring, which walks on from the first; none where nothing was measured).
   struct NextRings {
     std::optional<Eigen::Vector3d> first, second;
+    Eigen::Vector3d from = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::Zero();  // the walk's
+    int first_step = 0;
   };
-  NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side, bool two) const {
+  NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side) const {
     NextRings rings;
-    const Eigen::Vector3d d = c.normalized();
-    const Eigen::Vector3d across = d.cross(line);  // in the image, across the line's image
+    rings.from = c.normalized();
+    const Eigen::Vector3d across = rings.from.cross(line);  // in the image, across the line's image
     if (!(across.norm() > 1e-6)) return rings;  // the line runs along the line of sight
-    const Eigen::Vector3d axis = side * across.normalized();
-    const std::optional<Measured> first = first_measured(d, axis, true);
+    rings.axis = side * across.normalized();
+    const std::optional<Measured> first = first_measured(rings.from, rings.axis, true);
     if (!first) return rings;
     rings.first = point_of(*first);
-    if (!two) return rings;
-    const std::optional<Measured> second = first_measured(d, axis, true, first->step + 1, 2 * kRingSteps);
-    if (second) rings.second = point_of(*second);
+    rings.first_step = first->step;
     return rings;
+  }
+  void add_second_ring(NextRings& rings) const {
+    if (!rings.first) return;
+    const std::optional<Measured> second =
+        first_measured(rings.from, rings.axis, true, rings.first_step + 1, 2 * kRingSteps);
+    if (second) rings.second = point_of(*second);
   }
 
   // The camera-frame point at `depth` along the centre of cell `index`.
@@ -362,16 +368,20 @@ class DepthView {
     return inset < pixels;
   }
 
-  // For a cloud, the world points of the next ring (or two) on one side of a ring's world-frame
-  // line through `world` (CubeRangeImage::next_rings); none for an image.
-  CubeRangeImage::NextRings next_rings(const Eigen::Vector3d& world, const Eigen::Vector3d& line, double side,
-                                       bool two) const {
+  // For a cloud, the world points of the next ring on one side of a ring's world-frame line
+  // through `world` (CubeRangeImage::next_rings), and of the one after (add_second_ring); none
+  // for an image.
+  CubeRangeImage::NextRings next_rings(const Eigen::Vector3d& world, const Eigen::Vector3d& line, double side) const {
     CubeRangeImage::NextRings rings;
     if (!cube_) return rings;
-    rings = cube_->next_rings(camera_T_world_ * world, camera_T_world_.linear() * line, side, two);
-    for (std::optional<Eigen::Vector3d>* m : {&rings.first, &rings.second})
-      if (*m) *m = frame_.world_T_camera * **m;
+    rings = cube_->next_rings(camera_T_world_ * world, camera_T_world_.linear() * line, side);
+    if (rings.first) rings.first = frame_.world_T_camera * *rings.first;
     return rings;
+  }
+  void add_second_ring(CubeRangeImage::NextRings& rings) const {
+    if (!cube_) return;
+    cube_->add_second_ring(rings);
+    if (rings.second) rings.second = frame_.world_T_camera * *rings.second;
   }
 
   // For a cloud, whether it measured around the point (CubeRangeImage::measured_around); an
@@ -1037,9 +1047,9 @@ class LeafQueries {
   // far (tests/core, "a counter top 4 cm thick").
   Eigen::Vector3d plane_to_next_rings(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
                                       const Eigen::Vector3d& line) const {
-    std::optional<Eigen::Vector3d> next = next_ring_between(p, line);  // the point the plane passes through
-    if (!next) next = next_ring_on_one_side(p, line);
-    const std::optional<Eigen::Vector3d> n = next ? plane_normal(line, *next - p) : std::nullopt;
+    CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0), above = view_.next_rings(p, line, 1.0);
+    std::optional<Eigen::Vector3d> n = plane_between_rings(p, line, below, above);
+    if (!n) n = plane_to_one_side(p, line, below, above);
     if (!n) return Eigen::Vector3d::Zero();
     return n->dot(u) < 0.0 ? Eigen::Vector3d(-*n) : *n;
   }
@@ -1051,32 +1061,34 @@ class LeafQueries {
     return n.normalized();
   }
 
-  // Between two rings of one surface: the nearer of the next rings on either side, where the
-  // plane through it and the line passes within a voxel of the other.
-  std::optional<Eigen::Vector3d> next_ring_between(const Eigen::Vector3d& p, const Eigen::Vector3d& line) const {
-    const CubeRangeImage::NextRings below = view_.next_rings(p, line, -1.0, false);
-    const CubeRangeImage::NextRings above = view_.next_rings(p, line, 1.0, false);
+  // Between two rings of one surface: the plane through the line and the nearer of the next
+  // rings on either side, where it passes within a voxel of the other.
+  std::optional<Eigen::Vector3d> plane_between_rings(const Eigen::Vector3d& p, const Eigen::Vector3d& line,
+                                                     const CubeRangeImage::NextRings& below,
+                                                     const CubeRangeImage::NextRings& above) const {
     if (!below.first || !above.first) return std::nullopt;
     const bool below_nearer = (*below.first - p).squaredNorm() < (*above.first - p).squaredNorm();
     const Eigen::Vector3d& nearer = below_nearer ? *below.first : *above.first;
     const Eigen::Vector3d& farther = below_nearer ? *above.first : *below.first;
     const std::optional<Eigen::Vector3d> n = plane_normal(line, nearer - p);
     if (!n || !(std::abs(n->dot(farther - p)) <= vg_)) return std::nullopt;
-    return nearer;
+    return n;
   }
 
-  // A surface's first or last ring: the nearer next ring of a side whose next two rings span a
-  // plane that the line lies on, within kOnRingPlaneVoxels.
-  std::optional<Eigen::Vector3d> next_ring_on_one_side(const Eigen::Vector3d& p, const Eigen::Vector3d& line) const {
+  // A surface's first or last ring: the plane through the line and the nearer next ring of a
+  // side whose next two rings span a plane that the line lies on, within kOnRingPlaneVoxels.
+  std::optional<Eigen::Vector3d> plane_to_one_side(const Eigen::Vector3d& p, const Eigen::Vector3d& line,
+                                                   CubeRangeImage::NextRings& below,
+                                                   CubeRangeImage::NextRings& above) const {
     std::optional<Eigen::Vector3d> next;
-    for (double side : {-1.0, 1.0}) {
-      const CubeRangeImage::NextRings rings = view_.next_rings(p, line, side, true);
-      if (!rings.first || !rings.second) continue;
-      const std::optional<Eigen::Vector3d> n = plane_normal(line, *rings.second - *rings.first);
-      if (!n || !(std::abs(n->dot(p - *rings.first)) <= kOnRingPlaneVoxels * vg_)) continue;
-      if (!next || (*rings.first - p).squaredNorm() < (*next - p).squaredNorm()) next = rings.first;
+    for (CubeRangeImage::NextRings* rings : {&below, &above}) {
+      view_.add_second_ring(*rings);
+      if (!rings->first || !rings->second) continue;
+      const std::optional<Eigen::Vector3d> n = plane_normal(line, *rings->second - *rings->first);
+      if (!n || !(std::abs(n->dot(p - *rings->first)) <= kOnRingPlaneVoxels * vg_)) continue;
+      if (!next || (*rings->first - p).squaredNorm() < (*next - p).squaredNorm()) next = rings->first;
     }
-    return next;
+    return next ? plane_normal(line, *next - p) : std::nullopt;
   }
 
   // Appends a vote field by field (as append_run: no Vote built on the stack and copied).
