@@ -216,25 +216,30 @@ class CubeRangeImage {
   // (add_second_ring, which walks on from the first; none where nothing was measured).
   struct NextRings {
     std::optional<Eigen::Vector3d> first, second;
-    Eigen::Vector3d from = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::Zero();  // the walk's
-    int first_step = 0;
+    // Where add_second_ring walks on from: the cube's own camera-frame walk, which the world
+    // frame's callers pass back untouched.
+    struct Walk {
+      Eigen::Vector3d from = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::Zero();
+      int first_step = 0;
+    } walk;
   };
   NextRings next_rings(const Eigen::Vector3d& c, const Eigen::Vector3d& line, double side) const {
     NextRings rings;
-    rings.from = c.normalized();
-    const Eigen::Vector3d across = rings.from.cross(line);  // in the image, across the line's image
+    NextRings::Walk& walk = rings.walk;
+    walk.from = c.normalized();
+    const Eigen::Vector3d across = walk.from.cross(line);  // in the image, across the line's image
     if (!(across.norm() > 1e-6)) return rings;  // the line runs along the line of sight
-    rings.axis = side * across.normalized();
-    const std::optional<Measured> first = first_measured(rings.from, rings.axis, true);
+    walk.axis = side * across.normalized();
+    const std::optional<Measured> first = first_measured(walk.from, walk.axis, true);
     if (!first) return rings;
     rings.first = point_of(*first);
-    rings.first_step = first->step;
+    walk.first_step = first->step;
     return rings;
   }
   void add_second_ring(NextRings& rings) const {
     if (!rings.first) return;
     const std::optional<Measured> second =
-        first_measured(rings.from, rings.axis, true, rings.first_step + 1, 2 * kRingSteps);
+        first_measured(rings.walk.from, rings.walk.axis, true, rings.walk.first_step + 1, 2 * kRingSteps);
     if (second) rings.second = point_of(*second);
   }
 
