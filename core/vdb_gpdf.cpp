@@ -329,6 +329,7 @@ class DepthView {
       : frame_(frame), camera_T_world_(frame.world_T_camera.inverse()),
         image_(has_depth_image(frame)) {  // throws when the image is not width x height
     if (!image_) cube_ = std::make_unique<const CubeRangeImage>(frame.points_camera);
+    else find_silhouettes();
   }
 
   // A world point as the camera sees it: its camera coordinates and its pixel (none outside
@@ -395,6 +396,17 @@ class DepthView {
     return !s.cell || cube_->measured_around(s.camera, s.cell->index, voxel);
   }
 
+  // In the image, within a tile of kSilhouetteTile pixels (or a tile beside it) that holds a
+  // silhouette: a pixel whose neighbour two pixels right or down measured farther or nearer by
+  // over kSilhouetteJump of the nearer depth (at least of 1 m), or measured where it did not. One
+  // byte read, a cheap test before a dearer one. A cloud answers true.
+  bool near_silhouette(const Sight& s) const {
+    if (!image_) return true;
+    if (!s.pixel) return false;
+    return silhouette_tiles_[static_cast<size_t>(s.pixel->v / kSilhouetteTile) * tiles_across_ +
+                             s.pixel->u / kSilhouetteTile] != 0;
+  }
+
   // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
   bool seen_past(const Sight& s, double margin) const {
     const float d = measured_depth(s);
@@ -428,9 +440,42 @@ class DepthView {
   // The point's own depth, as its pixel or cell measures depth.
   static double depth_of(const Sight& s) { return s.cell ? s.cell->depth : s.camera.z(); }
 
+  static constexpr int kSilhouetteTile = 4;
+  static constexpr float kSilhouetteJump = 0.05f;  // depth noise grows with depth; edges jump more
+  static bool jumps(float a, float b) {
+    if ((a > 0.0f) != (b > 0.0f)) return true;
+    return std::abs(a - b) > kSilhouetteJump * std::max(1.0f, std::min(a, b));
+  }
+  // The tiles holding a silhouette, then each marked where a tile beside it holds one.
+  void find_silhouettes() {
+    const int w = frame_.width, h = frame_.height;
+    tiles_across_ = (w + kSilhouetteTile - 1) / kSilhouetteTile;
+    const int down = (h + kSilhouetteTile - 1) / kSilhouetteTile;
+    std::vector<uint8_t> own(static_cast<size_t>(tiles_across_) * down, 0);
+    // Every second pixel of every second row against the next such pixel right and down: a step
+    // between two neighbours is a step between the two pixels around them. Without branches:
+    // the last column and row meet themselves.
+    for (int v = 0; v < h; v += 2) {
+      const float* row = &frame_.depth[static_cast<size_t>(v) * w];
+      const float* below = v + 2 < h ? row + 2 * w : row;
+      uint8_t* tiles = &own[static_cast<size_t>(v / kSilhouetteTile) * tiles_across_];
+      for (int u = 0; u < w; u += 2)
+        tiles[u / kSilhouetteTile] |= jumps(row[u], row[std::min(u + 2, w - 1)]) | jumps(row[u], below[u]);
+    }
+    silhouette_tiles_.assign(own.size(), 0);
+    for (int ty = 0; ty < down; ++ty)
+      for (int tx = 0; tx < tiles_across_; ++tx)
+        for (int y = std::max(ty - 1, 0); y <= std::min(ty + 1, down - 1); ++y)
+          for (int x = std::max(tx - 1, 0); x <= std::min(tx + 1, tiles_across_ - 1); ++x)
+            silhouette_tiles_[static_cast<size_t>(ty) * tiles_across_ + tx] |=
+                own[static_cast<size_t>(y) * tiles_across_ + x];
+  }
+
   const Frame& frame_;
   Eigen::Isometry3d camera_T_world_;
   bool image_;
+  std::vector<uint8_t> silhouette_tiles_;  // images only
+  int tiles_across_ = 0;
   // Frames without an image. (A std::optional here drew GCC 12's -Wmaybe-uninitialized on its
   // vector in the sanitizer build, a false report.)
   std::unique_ptr<const CubeRangeImage> cube_;
@@ -876,11 +921,84 @@ void sum_points(const VdbGpdfConfig& config, const Frame& frame, PointSumGrid& g
 // leaf with fewer than half a plane's voxels keeps every one.
 constexpr size_t kSparseLeafCells = LeafCells::Leaf::DIM * LeafCells::Leaf::DIM / 2;
 
+// A local leaf's local voxels and those of its 26 neighbouring leaves, each leaf fetched once,
+// so that a voxel's 26 neighbours are read as bits of their leaves' masks.
+class LocalVoxelsAround {
+ public:
+  using Leaf = PointSumGrid::TreeType::LeafNodeType;
+  LocalVoxelsAround(const PointSumGrid& grid, const Leaf& leaf) : origin_(leaf.origin()) {
+    const auto acc = grid.getConstAccessor();
+    const int dim = static_cast<int>(Leaf::DIM);
+    for (int i = 0; i < 27; ++i)
+      leaves_[i] = acc.probeConstLeaf(origin_.offsetBy((i / 9 - 1) * dim, (i / 3 % 3 - 1) * dim, (i % 3 - 1) * dim));
+  }
+  // Whether local voxel v (at most one voxel outside the leaf on each axis) holds points.
+  bool occupied(const openvdb::Coord& v) const {
+    const Leaf* leaf =
+        leaves_[9 * side(v.x() - origin_.x()) + 3 * side(v.y() - origin_.y()) + side(v.z() - origin_.z())];
+    return leaf != nullptr && leaf->isValueOn(v);
+  }
+
+ private:
+  static int side(int local) { return local < 0 ? 0 : local < static_cast<int>(Leaf::DIM) ? 1 : 2; }
+  openvdb::Coord origin_;
+  std::array<const Leaf*, 27> leaves_{};
+};
+
+// Where the surface through local voxel v ends, as the sensor at `eye` sees it: the unit
+// direction across the line of sight in which it ends, or none. It ends there when v's surface
+// is one local voxel thick (at most kEdgeNeighbours of its 26 neighbours hold points) and the
+// sum of their offsets across the line of sight is kEdgeImbalance voxels or more and half their
+// count (on a plane's edge 3 of its 5 neighbours lie inward: 3; at its corner, (2, 2) of 3;
+// inside a plane they cancel). Depth noise thickens far surfaces along the line of sight into
+// shells whose outer cells lean inward too: a count above a plane's 8 rules them out (without
+// it, four in five local voxels of the room's 640 x 480 frames counted).
+constexpr int kEdgeNeighbours = 8;
+constexpr double kEdgeImbalance = 2.0;
+std::optional<Eigen::Vector3d> surface_end(const LocalVoxelsAround& around, const openvdb::Coord& v,
+                                           const Eigen::Vector3d& centroid, const Eigen::Vector3d& eye) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if ((dx | dy | dz) == 0 || !around.occupied(v.offsetBy(dx, dy, dz))) continue;
+        if (++count > kEdgeNeighbours) return std::nullopt;
+        sum += Eigen::Vector3d(dx, dy, dz);
+      }
+  const Eigen::Vector3d ray = (centroid - eye).normalized();
+  const Eigen::Vector3d across = sum - sum.dot(ray) * ray;
+  if (across.norm() < kEdgeImbalance || across.norm() < 0.5 * count) return std::nullopt;
+  return Eigen::Vector3d(-across.normalized());
+}
+
+// Whether local voxel v (its points' centroid c) lies on an edge of its surface that the sensor
+// saw past: a local voxel beyond it, its pixel (or cell) measured a surface more than a global
+// voxel farther. Every voxel_downsample-th local voxel trains the GPs, so their field put an
+// edge up to that spacing short of the points: a 4 cm slab's side seen at 7 degrees read 2 cm
+// short, 0.2 m too far in the circle; such voxels train the GPs too (docs/fidelity.md, "A
+// surface's edge in the training points"). Where the view's edge cut the surface, nothing was
+// measured beyond it and the surface goes on: a training point there carried a table's top a
+// voxel past its corner below the view (test "a table whose corner stays just below the view").
+// `around` is fetched for the first voxel of a leaf that passes the image's cheap test.
+bool at_seen_edge(std::optional<LocalVoxelsAround>& around, const PointSumGrid& points,
+                  const PointSumGrid::TreeType::LeafNodeType& leaf, const DepthView& view,
+                  const openvdb::Coord& v, const Eigen::Vector3d& c, const Eigen::Vector3d& eye,
+                  const VdbGpdfConfig& config) {
+  if (!view.near_silhouette(view.sight(c))) return false;
+  if (!around) around.emplace(points, leaf);
+  const std::optional<Eigen::Vector3d> end = surface_end(*around, v, c, eye);
+  return end && view.seen_past(view.sight(c + *end * config.local_voxel), config.global_voxel);
+}
+
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
 // centroids of every voxel_downsample-th occupied local voxel, or of every one in a cloud's
-// sparse leaf; not the voxel centres: centres put a face up to half a local voxel inside or
-// outside it), their box, and its cells; then the leaf index and the neighbour links.
-void index_local_leaves(const VdbGpdfConfig& config, bool cloud, LocalFrame& out) {
+// sparse leaf, then of the others on an edge that the sensor saw past; not the voxel centres:
+// centres put a face up to half a local voxel inside or outside it), their box, and its cells;
+// then the leaf index and the neighbour links.
+void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, const Eigen::Vector3d& eye,
+                        LocalFrame& out) {
+  const bool cloud = !view.has_image();
   std::vector<const PointSumGrid::TreeType::LeafNodeType*> leaves;
   for (auto leaf = out.points.tree().cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
   const size_t n = leaves.size();
@@ -899,17 +1017,24 @@ void index_local_leaves(const VdbGpdfConfig& config, bool cloud, LocalFrame& out
     cells[i].trained.reserve(on / stride + 1);
     out.training[i].reserve(on / stride + 1);
     cells[i].cell_of.fill(-1);
+    std::optional<LocalVoxelsAround> around;
+    std::vector<Eigen::Vector3f> at_edges;
     int k = 0;
     for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
       const Eigen::Vector3d c = centroid(*v);
       cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
       if (cloud) cells[i].box.extend(c);  // for WideNeighbourhood, clouds only
-      if (k % stride != 0) continue;
-      out.training[i].push_back(c.cast<float>());
-      cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
-      gps.bounds[i].extend(out.training[i].back().cast<double>());
+      if (k % stride == 0) {
+        out.training[i].push_back(c.cast<float>());
+        cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
+      } else if (at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config)) {
+        at_edges.push_back(c.cast<float>());
+        cells[i].trained.emplace_back(voxel_of(at_edges.back().cast<double>(), config.global_voxel));
+      }
     }
+    out.training[i].insert(out.training[i].end(), at_edges.begin(), at_edges.end());
+    for (const Eigen::Vector3f& t : out.training[i]) gps.bounds[i].extend(t.cast<double>());
     gps.origins[i] = leaves[i]->origin();
     gps.centres[i] = leaf_centre(gps.origins[i], config.local_voxel);
   });
@@ -972,7 +1097,7 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
 
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out) {
   sum_points(config, frame, out.points);
-  index_local_leaves(config, !view.has_image(), out);
+  index_local_leaves(config, view, frame.world_T_camera.translation(), out);
   const std::vector<LeafCells>& cells = out.cells;
   openvdb::Int32Grid counts(0);
   parallel_both([&] { count_cells(cells, counts); }, [&] { near_surface(cells, out.near); });
