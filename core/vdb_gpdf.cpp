@@ -399,12 +399,14 @@ class DepthView {
   // In the image, within a tile of kSilhouetteTile pixels (or a tile beside it) that holds a
   // silhouette: a pixel whose neighbour two pixels right or down measured farther or nearer by
   // over kSilhouetteJump of the nearer depth (at least of 1 m), or measured where it did not. One
-  // byte read, a cheap test before a dearer one. A cloud answers true.
-  bool near_silhouette(const Sight& s) const {
+  // byte read, a cheap test before a dearer one. A cloud answers true at once (a Sight would
+  // find the point's cube cell, for nothing).
+  bool near_silhouette(const Eigen::Vector3d& world) const {
     if (!image_) return true;
-    if (!s.pixel) return false;
-    return silhouette_tiles_[static_cast<size_t>(s.pixel->v / kSilhouetteTile) * tiles_across_ +
-                             s.pixel->u / kSilhouetteTile] != 0;
+    const std::optional<Pixel> px = pixel_of(frame_.intrinsics, frame_.width, frame_.height, camera_T_world_ * world);
+    if (!px) return false;
+    return silhouette_tiles_[static_cast<size_t>(px->v / kSilhouetteTile) * tiles_across_ + px->u / kSilhouetteTile] !=
+           0;
   }
 
   // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
@@ -985,7 +987,7 @@ bool at_seen_edge(std::optional<LocalVoxelsAround>& around, const PointSumGrid& 
                   const PointSumGrid::TreeType::LeafNodeType& leaf, const DepthView& view,
                   const openvdb::Coord& v, const Eigen::Vector3d& c, const Eigen::Vector3d& eye,
                   const VdbGpdfConfig& config) {
-  if (!view.near_silhouette(view.sight(c))) return false;
+  if (!view.near_silhouette(c)) return false;
   if (!around) around.emplace(points, leaf);
   const std::optional<Eigen::Vector3d> end = surface_end(*around, v, c, eye);
   return end && view.seen_past(view.sight(c + *end * config.local_voxel), config.global_voxel);
