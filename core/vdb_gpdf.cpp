@@ -444,33 +444,50 @@ class DepthView {
 
   static constexpr int kSilhouetteTile = 4;
   static constexpr float kSilhouetteJump = 0.05f;  // depth noise grows with depth; edges jump more
-  static bool jumps(float a, float b) {
-    if ((a > 0.0f) != (b > 0.0f)) return true;
-    return std::abs(a - b) > kSilhouetteJump * std::max(1.0f, std::min(a, b));
+  static bool jumps(float a, float b) {  // without branches: `|`, not `||`
+    return ((a > 0.0f) != (b > 0.0f)) | (std::abs(a - b) > kSilhouetteJump * std::max(1.0f, std::min(a, b)));
   }
-  // The tiles holding a silhouette, then each marked where a tile beside it holds one.
+  // The tiles holding a silhouette, each then marked where a tile beside it holds one: across
+  // while the rows are found, then up and down, each pass in parallel over rows of tiles.
   void find_silhouettes() {
     const int w = frame_.width, h = frame_.height;
     tiles_across_ = (w + kSilhouetteTile - 1) / kSilhouetteTile;
-    const int down = (h + kSilhouetteTile - 1) / kSilhouetteTile;
-    std::vector<uint8_t> own(static_cast<size_t>(tiles_across_) * down, 0);
-    // Every second pixel of every second row against the next such pixel right and down: a step
-    // between two neighbours is a step between the two pixels around them. Without branches:
-    // the last column and row meet themselves.
-    for (int v = 0; v < h; v += 2) {
+    const size_t across = static_cast<size_t>(tiles_across_);
+    const size_t down = static_cast<size_t>((h + kSilhouetteTile - 1) / kSilhouetteTile);
+    std::vector<uint8_t> widened(across * down, 0);
+    parallel_for_each_index(down, [&](size_t ty) {
+      std::vector<uint8_t> own(across, 0);
+      mark_silhouette_row(static_cast<int>(ty), own.data());
+      uint8_t* row = &widened[ty * across];
+      for (size_t tx = 0; tx < across; ++tx)
+        row[tx] = own[tx] | (tx > 0 ? own[tx - 1] : 0) | (tx + 1 < across ? own[tx + 1] : 0);
+    });
+    silhouette_tiles_.assign(widened.size(), 0);
+    parallel_for_each_index(down, [&](size_t ty) {
+      uint8_t* row = &silhouette_tiles_[ty * across];
+      for (size_t y = ty > 0 ? ty - 1 : 0; y <= std::min(ty + 1, down - 1); ++y)
+        for (size_t tx = 0; tx < across; ++tx) row[tx] |= widened[y * across + tx];
+    });
+  }
+  // One row of tiles: every second pixel of every second row against the next such pixel right
+  // and down (a step between two neighbours is a step between the two pixels around them), a
+  // tile (its two pixels of the row) at a time. The last tile's last pixel meets the row's last
+  // one, the last row meets itself.
+  void mark_silhouette_row(int ty, uint8_t* tiles) const {
+    static_assert(kSilhouetteTile == 4, "two compared pixels per tile row");
+    const int w = frame_.width, h = frame_.height;
+    for (int v = ty * kSilhouetteTile; v < std::min((ty + 1) * kSilhouetteTile, h); v += 2) {
       const float* row = &frame_.depth[static_cast<size_t>(v) * w];
       const float* below = v + 2 < h ? row + 2 * w : row;
-      uint8_t* tiles = &own[static_cast<size_t>(v / kSilhouetteTile) * tiles_across_];
-      for (int u = 0; u < w; u += 2)
-        tiles[u / kSilhouetteTile] |= jumps(row[u], row[std::min(u + 2, w - 1)]) | jumps(row[u], below[u]);
+      int tx = 0;
+      for (; 4 * tx + 4 < w; ++tx) {
+        const float* p = row + 4 * tx;
+        const float* q = below + 4 * tx;
+        tiles[tx] |= jumps(p[0], p[2]) | jumps(p[2], p[4]) | jumps(p[0], q[0]) | jumps(p[2], q[2]);
+      }
+      for (int u = 4 * tx; u < w; u += 2)
+        tiles[tx] |= jumps(row[u], row[std::min(u + 2, w - 1)]) | jumps(row[u], below[u]);
     }
-    silhouette_tiles_.assign(own.size(), 0);
-    for (int ty = 0; ty < down; ++ty)
-      for (int tx = 0; tx < tiles_across_; ++tx)
-        for (int y = std::max(ty - 1, 0); y <= std::min(ty + 1, down - 1); ++y)
-          for (int x = std::max(tx - 1, 0); x <= std::min(tx + 1, tiles_across_ - 1); ++x)
-            silhouette_tiles_[static_cast<size_t>(ty) * tiles_across_ + tx] |=
-                own[static_cast<size_t>(y) * tiles_across_ + x];
   }
 
   const Frame& frame_;
