@@ -1343,7 +1343,21 @@ class LeafQueries {
 // order: the result does not depend on the thread count.
 void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface,
                  LateralVoteGrid& lateral, openvdb::MaskGrid& beside_rays) {
+  using CountsLeaf = VoteGrid::TreeType::LeafNodeType;
+  static_assert(CountsLeaf::DIM == kLeafDim, "leaf_origin_of finds the counts' leaves");
   auto acc = counts.getAccessor();
+  // A source's votes lie along its ray, mostly in one leaf: the leaf of the vote before and its
+  // values are kept (the accessor's own cache is asked twice a vote, for the value and to set
+  // it, and each leaf value read checks whether the leaf's buffer is loaded).
+  CountsLeaf* leaf = nullptr;
+  VoteCounts* values = nullptr;
+  auto counts_leaf = [&](const openvdb::Coord& v) -> CountsLeaf& {
+    if (leaf == nullptr || leaf_origin_of(v) != leaf->origin()) {
+      leaf = acc.touchLeaf(v);
+      values = leaf->buffer().data();
+    }
+    return *leaf;
+  };
   auto surface_acc = surface.getAccessor();
   auto lateral_acc = lateral.getAccessor();
   auto beside_acc = beside_rays.getAccessor();
@@ -1355,7 +1369,7 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
       }
       if (vote.kind == kLateral) {
         lateral_acc.setValue(vote.voxel, lateral_acc.getValue(vote.voxel) + openvdb::Vec2s(vote.offset, 1.0f));
-        acc.setValueOn(vote.voxel);
+        counts_leaf(vote.voxel).setValueOn(vote.voxel);
         continue;
       }
       if (vote.kind == kSurface) {
@@ -1364,12 +1378,13 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
         sums[at] += vote.offset;
         sums[at + 1] += 1.0f;
         surface_acc.setValue(vote.voxel, sums);
-        acc.setValueOn(vote.voxel);  // every voted voxel is visited through `counts`
+        counts_leaf(vote.voxel).setValueOn(vote.voxel);  // every voted voxel is visited through `counts`
         continue;
       }
-      VoteCounts c = acc.getValue(vote.voxel);
-      ++c[vote.kind];
-      acc.setValue(vote.voxel, c);
+      CountsLeaf& l = counts_leaf(vote.voxel);
+      const openvdb::Index i = CountsLeaf::coordToOffset(vote.voxel);
+      ++values[i][vote.kind];
+      l.setValueOn(i);
     }
 }
 
