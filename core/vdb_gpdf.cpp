@@ -1339,25 +1339,43 @@ class LeafQueries {
   WideNeighbourhood wide_;
 };
 
+// The counts' writes of count_votes. A source's votes lie along its ray, mostly in one leaf: the
+// leaf of the vote before and its values are kept (the accessor's own cache was asked twice a
+// vote, for the value and to set it, and each leaf value read checked whether the leaf's buffer
+// is loaded).
+class VoteCountsWriter {
+ public:
+  explicit VoteCountsWriter(VoteGrid& counts) : acc_(counts.getAccessor()) {}
+  // Marks voxel v voted, its counts unchanged.
+  void activate(const openvdb::Coord& v) { leaf(v).setValueOn(v); }
+  // Adds one vote of `kind` (kHitInside .. kFree) to voxel v.
+  void count(const openvdb::Coord& v, VoteKind kind) {
+    Leaf& l = leaf(v);
+    const openvdb::Index i = Leaf::coordToOffset(v);
+    ++values_[i][kind];
+    l.setValueOn(i);
+  }
+
+ private:
+  using Leaf = VoteGrid::TreeType::LeafNodeType;
+  static_assert(Leaf::DIM == kLeafDim, "leaf_origin_of finds the counts' leaves");
+  Leaf& leaf(const openvdb::Coord& v) {
+    if (leaf_ == nullptr || leaf_origin_of(v) != leaf_->origin()) {
+      leaf_ = acc_.touchLeaf(v);
+      values_ = leaf_->buffer().data();
+    }
+    return *leaf_;
+  }
+  VoteGrid::Accessor acc_;
+  Leaf* leaf_ = nullptr;
+  VoteCounts* values_ = nullptr;
+};
+
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
 // order: the result does not depend on the thread count.
 void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface,
                  LateralVoteGrid& lateral, openvdb::MaskGrid& beside_rays) {
-  using CountsLeaf = VoteGrid::TreeType::LeafNodeType;
-  static_assert(CountsLeaf::DIM == kLeafDim, "leaf_origin_of finds the counts' leaves");
-  auto acc = counts.getAccessor();
-  // A source's votes lie along its ray, mostly in one leaf: the leaf of the vote before and its
-  // values are kept (the accessor's own cache is asked twice a vote, for the value and to set
-  // it, and each leaf value read checks whether the leaf's buffer is loaded).
-  CountsLeaf* leaf = nullptr;
-  VoteCounts* values = nullptr;
-  auto counts_leaf = [&](const openvdb::Coord& v) -> CountsLeaf& {
-    if (leaf == nullptr || leaf_origin_of(v) != leaf->origin()) {
-      leaf = acc.touchLeaf(v);
-      values = leaf->buffer().data();
-    }
-    return *leaf;
-  };
+  VoteCountsWriter counted(counts);
   auto surface_acc = surface.getAccessor();
   auto lateral_acc = lateral.getAccessor();
   auto beside_acc = beside_rays.getAccessor();
@@ -1369,7 +1387,7 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
       }
       if (vote.kind == kLateral) {
         lateral_acc.setValue(vote.voxel, lateral_acc.getValue(vote.voxel) + openvdb::Vec2s(vote.offset, 1.0f));
-        counts_leaf(vote.voxel).setValueOn(vote.voxel);
+        counted.activate(vote.voxel);
         continue;
       }
       if (vote.kind == kSurface) {
@@ -1378,13 +1396,10 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
         sums[at] += vote.offset;
         sums[at + 1] += 1.0f;
         surface_acc.setValue(vote.voxel, sums);
-        counts_leaf(vote.voxel).setValueOn(vote.voxel);  // every voted voxel is visited through `counts`
+        counted.activate(vote.voxel);  // every voted voxel is visited through `counts`
         continue;
       }
-      CountsLeaf& l = counts_leaf(vote.voxel);
-      const openvdb::Index i = CountsLeaf::coordToOffset(vote.voxel);
-      ++values[i][vote.kind];
-      l.setValueOn(i);
+      counted.count(vote.voxel, vote.kind);
     }
 }
 
