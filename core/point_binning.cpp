@@ -9,13 +9,14 @@ namespace sonomap {
 
 namespace {
 
-SONOMAP_VECTOR_LOOP void bin_batch(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+// Reads the camera points straight from their (x, y, z) floats: the batch holds no copy.
+SONOMAP_VECTOR_LOOP void bin_batch(const float* xyz, size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
   const PointBinner::Pose at = pose;  // locals: a load inside a select could trap (see the top-level CMakeLists.txt)
   for (size_t i = 0; i < n; ++i) {
-    const double cx = b.cx[i], cy = b.cy[i], cz = b.cz[i];
+    const double cx = xyz[3 * i], cy = xyz[3 * i + 1], cz = xyz[3 * i + 2];
     const double r2 = (cx * cx + cy * cy) + cz * cz;
     // NaN and infinity fail one of the comparisons: such points are not fused.
-    b.fused[i] = (r2 >= at.min2) & (r2 <= at.max2);
+    const bool fused = (r2 >= at.min2) & (r2 <= at.max2);
     // The sums associate as Eigen's 3x3 product did before this pass (rows 0 and 1 left to
     // right, row 2 from the right), so maps stayed the same to the bit.
     const double x = ((at.rotation[0] * cx + at.rotation[3] * cy) + at.rotation[6] * cz) + at.translation[0];
@@ -24,18 +25,23 @@ SONOMAP_VECTOR_LOOP void bin_batch(size_t n, const PointBinner::Pose& pose, Poin
     b.x[i] = static_cast<float>(x);
     b.y[i] = static_cast<float>(y);
     b.z[i] = static_cast<float>(z);
-    b.vx[i] = std::floor(x * at.inverse_voxel);
-    b.vy[i] = std::floor(y * at.inverse_voxel);
-    b.vz[i] = std::floor(z * at.inverse_voxel);
+    // A point that is not fused may lie anywhere (or nowhere): its voxel is 0, not converted.
+    b.vx[i] = static_cast<int32_t>(fused ? std::floor(x * at.inverse_voxel) : 0.0);
+    b.vy[i] = static_cast<int32_t>(fused ? std::floor(y * at.inverse_voxel) : 0.0);
+    b.vz[i] = static_cast<int32_t>(fused ? std::floor(z * at.inverse_voxel) : 0.0);
+    b.fused[i] = fused;
   }
 }
 
-void bin_baseline(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) { bin_batch(n, pose, b); }
-SONOMAP_AVX2_KERNEL void bin_avx2(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
-  bin_batch(n, pose, b);
+void bin_baseline(const float* xyz, size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+  bin_batch(xyz, n, pose, b);
 }
-SONOMAP_AVX512_KERNEL void bin_avx512(size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
-  bin_batch(n, pose, b);
+SONOMAP_AVX2_KERNEL void bin_avx2(const float* xyz, size_t n, const PointBinner::Pose& pose, PointBinner::Batch& b) {
+  bin_batch(xyz, n, pose, b);
+}
+SONOMAP_AVX512_KERNEL void bin_avx512(const float* xyz, size_t n, const PointBinner::Pose& pose,
+                                      PointBinner::Batch& b) {
+  bin_batch(xyz, n, pose, b);
 }
 
 }  // namespace
@@ -48,12 +54,8 @@ PointBinner::PointBinner(double voxel, double min_range, double max_range,
 }
 
 void PointBinner::bin(const Eigen::Vector3f* points, size_t n, Batch& out) const {
-  for (size_t i = 0; i < n; ++i) {
-    out.cx[i] = points[i].x();
-    out.cy[i] = points[i].y();
-    out.cz[i] = points[i].z();
-  }
-  kernel_for(vector_isa(), &bin_baseline, &bin_avx2, &bin_avx512)(n, pose_, out);
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "points are packed (x, y, z) floats");
+  kernel_for(vector_isa(), &bin_baseline, &bin_avx2, &bin_avx512)(reinterpret_cast<const float*>(points), n, pose_, out);
 }
 
 }  // namespace sonomap

@@ -18,13 +18,10 @@ class PointBinner {
   static constexpr size_t kBatch = 256;
 
   struct Batch {
-    double cx[kBatch], cy[kBatch], cz[kBatch];  // the points in the camera frame
-    float x[kBatch], y[kBatch], z[kBatch];       // world position, as point sums add it
-    double vx[kBatch], vy[kBatch], vz[kBatch];   // floor(world position / voxel)
-    int64_t fused[kBatch];                       // 1 if the point is fused, else 0
-    openvdb::Coord voxel(size_t i) const {
-      return openvdb::Coord(static_cast<int>(vx[i]), static_cast<int>(vy[i]), static_cast<int>(vz[i]));
-    }
+    float x[kBatch], y[kBatch], z[kBatch];        // world position, as point sums add it
+    int32_t vx[kBatch], vy[kBatch], vz[kBatch];   // floor(world position / voxel); 0 if not fused
+    int32_t fused[kBatch];                        // 1 if the point is fused, else 0
+    openvdb::Coord voxel(size_t i) const { return openvdb::Coord(vx[i], vy[i], vz[i]); }
   };
 
   // The camera pose and the limits, as plain numbers for the batch pass.

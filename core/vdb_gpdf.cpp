@@ -840,7 +840,8 @@ class PointSumLeaves {
   void add(const openvdb::Coord& v, const openvdb::Vec4f& sum) {
     Leaf& l = leaf(v);
     const openvdb::Index i = Leaf::coordToOffset(v);
-    l.setValueOn(i, l.getValue(i) + sum);
+    last_values_[i] += sum;
+    l.setValueOn(i);
   }
 
   void move_into(PointSumGrid& grid) {
@@ -850,17 +851,22 @@ class PointSumLeaves {
   }
 
  private:
+  // A bucket's runs come in the image's order, a row's mostly in one leaf: the leaf of the run
+  // before and its values are kept (a value read through the leaf checks whether its buffer is
+  // loaded).
   Leaf& leaf(const openvdb::Coord& v) {
     const openvdb::Coord origin = leaf_origin_of(v);
     if (last_ != nullptr && last_->origin() == origin) return *last_;
     std::unique_ptr<Leaf>& slot = leaves_[origin];
     if (!slot) slot = std::make_unique<Leaf>(origin, openvdb::Vec4f(0.0f));
     last_ = slot.get();
+    last_values_ = last_->buffer().data();
     return *last_;
   }
 
   std::unordered_map<openvdb::Coord, std::unique_ptr<Leaf>, CoordHash> leaves_;
   Leaf* last_ = nullptr;
+  openvdb::Vec4f* last_values_ = nullptr;
 };
 
 // Consecutive fused points in one local voxel (neighbouring pixels mostly share one) and their
@@ -881,9 +887,11 @@ void append_run(std::vector<PointRun>& runs, const openvdb::Coord& voxel, const 
 }
 
 // The runs that start among points [begin, end), each summed to its end (past `end` if it goes
-// on: a run belongs whole to the chunk it starts in), sorted into their voxels' buckets.
+// on: a run belongs whole to the chunk it starts in), sorted into their voxels' buckets. The
+// sum is kept in four floats, added as Vec4f's += adds (x, y, z, 1): the same bits.
 void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& points, size_t begin,
                 size_t end, RunsPerBucket& buckets) {
+  for (std::vector<PointRun>& bucket : buckets) bucket.reserve((end - begin) / buckets.size());
   PointBinner::Batch b;
   openvdb::Coord run(std::numeric_limits<int>::min());
   for (size_t i = begin; i-- > 0;) {  // the run going on at `begin`, if any
@@ -894,25 +902,29 @@ void chunk_runs(const PointBinner& binner, const std::vector<Eigen::Vector3f>& p
     }
   }
   bool own = false;  // the current run started in this chunk
-  openvdb::Vec4f sum(0.0f);
+  float sx = 0.0f, sy = 0.0f, sz = 0.0f, count = 0.0f;
+  const auto close_run = [&] {
+    if (own) append_run(buckets[bucket_of(run)], run, openvdb::Vec4f(sx, sy, sz, count));
+  };
   for (size_t first = begin; first < points.size(); first += PointBinner::kBatch) {
     const size_t n = std::min(PointBinner::kBatch, points.size() - first);
     binner.bin(&points[first], n, b);
     for (size_t k = 0; k < n; ++k) {
       if (!b.fused[k]) continue;
-      const openvdb::Coord v = b.voxel(k);
-      if (v != run) {
-        if (own) append_run(buckets[bucket_of(run)], run, sum);
-        own = false;
+      if ((b.vx[k] != run.x()) | (b.vy[k] != run.y()) | (b.vz[k] != run.z())) {
+        close_run();
         if (first + k >= end) return;
-        run = v;
-        sum = openvdb::Vec4f(0.0f);
+        run = b.voxel(k);
+        sx = sy = sz = count = 0.0f;
         own = true;
       }
-      if (own) sum += openvdb::Vec4f(b.x[k], b.y[k], b.z[k], 1.0f);
+      sx += b.x[k];
+      sy += b.y[k];
+      sz += b.z[k];
+      count += 1.0f;
     }
   }
-  if (own) append_run(buckets[bucket_of(run)], run, sum);
+  close_run();
 }
 
 // Adds the frame's points in range to their local voxels: runs found per chunk of points, then
@@ -1010,6 +1022,14 @@ bool at_seen_edge(std::optional<LocalVoxelsAround>& around, const PointSumGrid& 
   return end && view.seen_past(view.sight(c + *end * config.local_voxel), config.global_voxel);
 }
 
+// Asks the memory for a local leaf's occupied sums at once, before the loop that reads them one
+// by one: the voxelise stage wrote them a few megabytes of leaves ago, so each is a cache miss,
+// and the loop's work per voxel is too long for the processor to overlap them on its own.
+void ask_for_sums(const PointSumGrid::TreeType::LeafNodeType& leaf) {
+  const openvdb::Vec4f* sums = leaf.buffer().data();
+  for (auto v = leaf.cbeginValueOn(); v; ++v) __builtin_prefetch(sums + v.pos());
+}
+
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
 // centroids of every voxel_downsample-th occupied local voxel, or of every one in a cloud's
 // sparse leaf, then of the others on an edge that the sensor saw past; not the voxel centres:
@@ -1036,6 +1056,7 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
     cells[i].trained.reserve(on / stride + 1);
     out.training[i].reserve(on / stride + 1);
     cells[i].cell_of.fill(-1);
+    ask_for_sums(*leaves[i]);
     std::optional<LocalVoxelsAround> around;
     std::vector<Eigen::Vector3f> at_edges;
     int k = 0;
@@ -1061,12 +1082,41 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
   gps.link_neighbours();
 }
 
+// Serial writes to a grid, voxel by voxel, where a write mostly lands in the leaf of the write
+// before (a source's votes lie along its ray, a local leaf's cells in one or two global
+// leaves): that leaf and its values are kept. Through the accessor, a count took two walks of
+// its cache (to read the value, then to set it) and each value read checked whether the
+// leaf's buffer is loaded.
+template <class GridT>
+class KeptLeafWriter {
+ public:
+  explicit KeptLeafWriter(GridT& grid) : acc_(grid.getAccessor()) {}
+  // Voxel v's value (the background's if v was not written before), v marked active.
+  typename GridT::ValueType& on(const openvdb::Coord& v) {
+    if (leaf_ == nullptr || leaf_origin_of(v) != leaf_->origin()) {
+      leaf_ = acc_.touchLeaf(v);
+      values_ = leaf_->buffer().data();
+    }
+    const openvdb::Index i = Leaf::coordToOffset(v);
+    leaf_->setValueOn(i);
+    return values_[i];
+  }
+
+ private:
+  using Leaf = typename GridT::TreeType::LeafNodeType;
+  static_assert(Leaf::DIM == kLeafDim, "leaf_origin_of finds the grid's leaves");
+  typename GridT::Accessor acc_;
+  Leaf* leaf_ = nullptr;
+  typename GridT::ValueType* values_ = nullptr;
+};
+
 // Per global voxel holding a local voxel's centroid: how many it holds, or -1 when it holds a
 // GP training point. (Serial: one pass of cheap adds, the centroids are computed already.)
 void count_cells(const std::vector<LeafCells>& leaves, openvdb::Int32Grid& counts) {
-  auto count = counts.getAccessor();
+  KeptLeafWriter<openvdb::Int32Grid> counted(counts);
   for (const LeafCells& leaf : leaves)
-    for (const auto& cell : leaf.cells) count.setValue(cell.global, count.getValue(cell.global) + 1);
+    for (const auto& cell : leaf.cells) ++counted.on(cell.global);
+  auto count = counts.getAccessor();
   for (const LeafCells& leaf : leaves)
     for (const openvdb::Coord& g : leaf.trained)
       if (count.isValueOn(g)) count.setValue(g, -1);
@@ -1339,43 +1389,11 @@ class LeafQueries {
   WideNeighbourhood wide_;
 };
 
-// The counts' writes of count_votes. A source's votes lie along its ray, mostly in one leaf: the
-// leaf of the vote before and its values are kept (the accessor's own cache was asked twice a
-// vote, for the value and to set it, and each leaf value read checked whether the leaf's buffer
-// is loaded).
-class VoteCountsWriter {
- public:
-  explicit VoteCountsWriter(VoteGrid& counts) : acc_(counts.getAccessor()) {}
-  // Marks voxel v voted, its counts unchanged.
-  void activate(const openvdb::Coord& v) { leaf(v).setValueOn(v); }
-  // Adds one vote of `kind` (kHitInside .. kFree) to voxel v.
-  void count(const openvdb::Coord& v, VoteKind kind) {
-    Leaf& l = leaf(v);
-    const openvdb::Index i = Leaf::coordToOffset(v);
-    ++values_[i][kind];
-    l.setValueOn(i);
-  }
-
- private:
-  using Leaf = VoteGrid::TreeType::LeafNodeType;
-  static_assert(Leaf::DIM == kLeafDim, "leaf_origin_of finds the counts' leaves");
-  Leaf& leaf(const openvdb::Coord& v) {
-    if (leaf_ == nullptr || leaf_origin_of(v) != leaf_->origin()) {
-      leaf_ = acc_.touchLeaf(v);
-      values_ = leaf_->buffer().data();
-    }
-    return *leaf_;
-  }
-  VoteGrid::Accessor acc_;
-  Leaf* leaf_ = nullptr;
-  VoteCounts* values_ = nullptr;
-};
-
 // Counts the frame's votes per global voxel (and sums the surface votes' offsets), in a fixed
 // order: the result does not depend on the thread count.
 void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, SurfaceVoteGrid& surface,
                  LateralVoteGrid& lateral, openvdb::MaskGrid& beside_rays) {
-  VoteCountsWriter counted(counts);
+  KeptLeafWriter<VoteGrid> counted(counts);
   auto surface_acc = surface.getAccessor();
   auto lateral_acc = lateral.getAccessor();
   auto beside_acc = beside_rays.getAccessor();
@@ -1387,7 +1405,7 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
       }
       if (vote.kind == kLateral) {
         lateral_acc.setValue(vote.voxel, lateral_acc.getValue(vote.voxel) + openvdb::Vec2s(vote.offset, 1.0f));
-        counted.activate(vote.voxel);
+        counted.on(vote.voxel);
         continue;
       }
       if (vote.kind == kSurface) {
@@ -1396,10 +1414,10 @@ void count_votes(const std::vector<std::vector<Vote>>& votes, VoteGrid& counts, 
         sums[at] += vote.offset;
         sums[at + 1] += 1.0f;
         surface_acc.setValue(vote.voxel, sums);
-        counted.activate(vote.voxel);  // every voted voxel is visited through `counts`
+        counted.on(vote.voxel);  // every voted voxel is visited through `counts`
         continue;
       }
-      counted.count(vote.voxel, vote.kind);
+      ++counted.on(vote.voxel)[vote.kind];
     }
 }
 
