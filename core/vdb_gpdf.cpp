@@ -621,20 +621,28 @@ struct LeafCells {
   std::array<int16_t, Leaf::SIZE> cell_of{};  // 1 kB a leaf: no bit counting per probe
 };
 
-// The offsets of the local voxels the PCA normal reads: a ball, not the cube (the cube's
-// corners add a third more probes and bias the neighbourhood toward the grid's diagonals),
-// in x, y, z nested order.
-constexpr int kNormalBall = 57;
-constexpr std::array<std::array<int8_t, 3>, kNormalBall> normal_ball() {
-  std::array<std::array<int8_t, 3>, kNormalBall> ball{};
-  int n = 0;
+// The local voxels the PCA normal reads: a ball, not the cube (the cube's corners add a third
+// more probes and bias the neighbourhood toward the grid's diagonals), 57 voxels. Per column
+// (dx, dy) the ball holds |dz| <= its reach (none where the reach is negative).
+using NormalBallColumns = std::array<std::array<int, 2 * kNormalReach + 1>, 2 * kNormalReach + 1>;
+constexpr NormalBallColumns normal_ball_columns() {
+  NormalBallColumns reach{};
   for (int dx = -kNormalReach; dx <= kNormalReach; ++dx)
-    for (int dy = -kNormalReach; dy <= kNormalReach; ++dy)
-      for (int dz = -kNormalReach; dz <= kNormalReach; ++dz)
-        if (dx * dx + dy * dy + dz * dz <= kNormalReach * kNormalReach + 1)
-          ball[n++] = {static_cast<int8_t>(dx), static_cast<int8_t>(dy), static_cast<int8_t>(dz)};
-  return ball;
+    for (int dy = -kNormalReach; dy <= kNormalReach; ++dy) {
+      int r = -1;
+      for (int dz = 0; dz <= kNormalReach; ++dz)
+        if (dx * dx + dy * dy + dz * dz <= kNormalReach * kNormalReach + 1) r = dz;
+      reach[dx + kNormalReach][dy + kNormalReach] = r;
+    }
+  return reach;
 }
+constexpr int voxels_in(const NormalBallColumns& columns) {
+  int n = 0;
+  for (const auto& row : columns)
+    for (const int reach : row) n += reach < 0 ? 0 : 2 * reach + 1;
+  return n;
+}
+static_assert(voxels_in(normal_ball_columns()) == 57, "the ball of radius sqrt(5) local voxels");
 
 // The local voxels within kNormalReach of one voxel, read through the (at most 2 x 2 x 2)
 // leaves they span, fetched once: one accessor probing the ball's 57 voxels bounced between
@@ -647,31 +655,51 @@ class NormalNeighbourhood {
   static_assert(Leaf::LOG2DIM == kLeafLog2 && Leaf::DIM > 2 * kNormalReach,
                 "leaf_origin_of() must find this grid's leaves, and the ball span two per axis at most");
   NormalNeighbourhood(const std::vector<LeafCells>& cells, const LocalGps::IndexAccessor& index,
-                      const openvdb::Coord& c)
-      : low_(leaf_origin_of(c.offsetBy(-kNormalReach))) {
+                      const openvdb::Coord& c) {
+    const openvdb::Coord low = leaf_origin_of(c.offsetBy(-kNormalReach));
     const openvdb::Coord high = leaf_origin_of(c.offsetBy(kNormalReach));
     for (int i = 0; i < 8; ++i) {
-      const openvdb::Coord origin = low_.offsetBy((i & 4) ? Leaf::DIM : 0, (i & 2) ? Leaf::DIM : 0,
-                                                  (i & 1) ? Leaf::DIM : 0);
+      const openvdb::Coord origin = low.offsetBy((i & 4) ? Leaf::DIM : 0, (i & 2) ? Leaf::DIM : 0,
+                                                 (i & 1) ? Leaf::DIM : 0);
       if (origin.x() > high.x() || origin.y() > high.y() || origin.z() > high.z()) continue;
       const int leaf = index.getValue(leaf_key_of(origin));
       leaves_[i] = leaf >= 0 ? &cells[leaf] : nullptr;
     }
+    for (int axis = 0; axis < 3; ++axis)
+      for (int d = -kNormalReach; d <= kNormalReach; ++d) {
+        const int v = c[axis] + d;
+        const bool high_leaf = v - low[axis] >= static_cast<int>(Leaf::DIM);
+        leaf_bit_[axis][d + kNormalReach] = static_cast<uint8_t>(high_leaf ? 4 >> axis : 0);
+        offset_[axis][d + kNormalReach] =
+            static_cast<uint16_t>((v & (Leaf::DIM - 1)) << ((2 - axis) * Leaf::LOG2DIM));  // as coordToOffset
+      }
   }
-  // The centroid of the points in local voxel v (within kNormalReach of the centre), or null.
-  const Eigen::Vector3d* centroid(const openvdb::Coord& v) const {
-    const int i = ((v.x() - low_.x()) >= static_cast<int>(Leaf::DIM) ? 4 : 0) |
-                  ((v.y() - low_.y()) >= static_cast<int>(Leaf::DIM) ? 2 : 0) |
-                  ((v.z() - low_.z()) >= static_cast<int>(Leaf::DIM) ? 1 : 0);
-    const LeafCells* leaf = leaves_[i];
-    if (!leaf) return nullptr;
-    const int cell = leaf->cell_of[Leaf::coordToOffset(v)];
-    return cell < 0 ? nullptr : &leaf->cells[cell].centroid;
+  // Calls visit(centroid) for each local voxel of the ball around c that holds points, in x, y, z
+  // nested order (the scatter's sums are added in that order).
+  template <class Visit>
+  void for_each_centroid(Visit&& visit) const {
+    static constexpr NormalBallColumns kColumns = normal_ball_columns();
+    for (int x = 0; x <= 2 * kNormalReach; ++x)
+      for (int y = 0; y <= 2 * kNormalReach; ++y) {
+        const int reach = kColumns[x][y];
+        const int column_bits = leaf_bit_[0][x] | leaf_bit_[1][y];
+        const int column_offset = offset_[0][x] + offset_[1][y];
+        for (int z = kNormalReach - reach; z <= kNormalReach + reach; ++z) {
+          const LeafCells* leaf = leaves_[column_bits | leaf_bit_[2][z]];
+          if (!leaf) continue;
+          const int cell = leaf->cell_of[column_offset + offset_[2][z]];
+          if (cell >= 0) visit(leaf->cells[cell].centroid);
+        }
+      }
   }
 
  private:
-  openvdb::Coord low_;
   std::array<const LeafCells*, 8> leaves_{};
+  // Per axis and offset from c (0 for -kNormalReach): the axis's bit of the index in leaves_ (the
+  // low or the high leaf along it) and its term of the voxel's offset in that leaf. A probe then
+  // adds table entries instead of comparing and masking coordinates.
+  std::array<std::array<uint8_t, 2 * kNormalReach + 1>, 3> leaf_bit_{};
+  std::array<std::array<uint16_t, 2 * kNormalReach + 1>, 3> offset_{};
 };
 
 // The scatter of points about p, as scalar sums: Eigen's outer product builds a 3x3 temporary
@@ -761,14 +789,10 @@ bool of_one_ring(const PlaneFit& fit, const Eigen::Vector3d& u) {
 // (A normal from the local GP's gradient one step toward the sensor was tried first: at grazing
 // views that point can still lie behind the sampled surface, the gradient then points into the
 // object, and front points land inside it: measured 13 cm deep in a box.)
-PlaneFit surface_normal(const NormalNeighbourhood& local, const openvdb::Coord& c, const Eigen::Vector3d& p,
-                        const Eigen::Vector3d& u, const WideNeighbourhood* wide, double wide_reach) {
+PlaneFit surface_normal(const NormalNeighbourhood& local, const Eigen::Vector3d& p, const Eigen::Vector3d& u,
+                        const WideNeighbourhood* wide, double wide_reach) {
   Scatter ball;
-  static constexpr std::array<std::array<int8_t, 3>, kNormalBall> kBall = normal_ball();
-  for (const auto& [dx, dy, dz] : kBall) {
-    const Eigen::Vector3d* at = local.centroid(c.offsetBy(dx, dy, dz));
-    if (at) ball.add(*at - p);
-  }
+  local.for_each_centroid([&](const Eigen::Vector3d& at) { ball.add(at - p); });
   const PlaneFit fit = fit_plane(ball, u);
   const bool too_few = ball.count < kMinPlanePoints;
   if (!wide || !(too_few || of_one_ring(fit, u))) return {fit.normal};
@@ -1201,7 +1225,7 @@ class LeafQueries {
     if (!(range > 0.0)) return;
     u /= range;  // toward the sensor: the direction the query points are placed along
     const openvdb::Coord c = voxel_of(p, config_.local_voxel);
-    const PlaneFit fit = surface_normal(NormalNeighbourhood(cells_, index_, c), c, p, u,
+    const PlaneFit fit = surface_normal(NormalNeighbourhood(cells_, index_, c), p, u,
                                         lateral_ ? &wide_ : nullptr, ring_reach(range));
     const Eigen::Vector3d normal = fit.line ? plane_to_next_rings(p, u, fit.along) : fit.normal;
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
