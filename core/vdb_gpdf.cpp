@@ -526,8 +526,8 @@ struct LocalGps {
   }
 
   // Calls f(index) for every leaf among the 26 around the leaf at `home`, in x, y, z order. When
-  // all 27 keys lie in one node of the index, they are read from its values (two in five
-  // leaves; the accessor spent about 57 instructions a key, most of a frame's queries' share).
+  // all 27 keys lie in one node of the index (two keys in five), they are read from its values:
+  // through the accessor a key cost about 57 instructions.
   template <typename F>
   void for_each_neighbour(const IndexAccessor& at, const openvdb::Coord& home, F&& f) const {
     using IndexNode = openvdb::Int32Tree::LeafNodeType;

@@ -52,6 +52,8 @@ TEST_CASE("Points nearer than the minimum range, beyond the maximum or not finit
   binner.bin(points.data(), points.size(), b);
   const std::vector<int64_t> fused(b.fused, b.fused + points.size());
   CHECK(fused == std::vector<int64_t>{0, 1, 1, 0, 0, 0, 0});
+  for (size_t i = 0; i < points.size(); ++i)  // wherever (or nowhere) it lies, not a voxel's index
+    if (!b.fused[i]) CHECK(b.voxel(i) == openvdb::Coord(0));
 }
 
 TEST_CASE("A full batch places every point as the camera pose does, lane by lane", "[point_binning]") {
