@@ -532,12 +532,10 @@ struct LocalGps {
   void for_each_neighbour(const IndexAccessor& at, const openvdb::Coord& home, F&& f) const {
     using IndexNode = openvdb::Int32Tree::LeafNodeType;
     const openvdb::Coord key = leaf_key_of(home);
-    const IndexNode* node = at.probeConstLeaf(key);
-    const openvdb::Coord inner = node ? key - node->origin() : openvdb::Coord(0);
-    const int last = static_cast<int>(IndexNode::DIM) - 1;
-    const bool interior = std::min({inner.x(), inner.y(), inner.z()}) >= 1 &&
-                          std::max({inner.x(), inner.y(), inner.z()}) < last;
-    const int* values = node != nullptr && interior ? node->buffer().data() : nullptr;
+    constexpr int kNodeOrigin = ~static_cast<int>(IndexNode::DIM - 1);  // a key's bits of its node's origin
+    const bool one_node = (key.offsetBy(-1) & kNodeOrigin) == (key.offsetBy(1) & kNodeOrigin);
+    const IndexNode* node = one_node ? at.probeConstLeaf(key) : nullptr;
+    const int* values = node ? node->buffer().data() : nullptr;
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
