@@ -23,9 +23,10 @@ install(TARGETS sonomap_open3d ${SONOMAP_ON_DEMAND_LIBRARIES} LIBRARY DESTINATIO
 install(TARGETS ${SONOMAP_EXPORTED_TARGETS} EXPORT sonomapTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# (core/vdb_gpdf/ holds VDB-GPDF's internal stages: no public header includes them.)
 foreach(dir core sim audio eval harness)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${dir} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/sonomap
-    FILES_MATCHING PATTERN "*.hpp")
+    FILES_MATCHING PATTERN "*.hpp" PATTERN "core/vdb_gpdf" EXCLUDE)
 endforeach()
 
 set(SONOMAP_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/sonomap)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// A ray's walk through grid cells, for VDB-GPDF's free-space carving (vdb_gpdf.cpp).
+// A ray's walk through grid cells, for VDB-GPDF's free-space carving (vdb_gpdf/votes.cpp).
 #pragma once
 
 #include <openvdb/openvdb.h>

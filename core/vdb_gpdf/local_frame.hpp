@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The frame on VDB-GPDF's fine local grid (stages "voxelise" and "local_gps"): its points summed
+// per local voxel, its local leaves' cells, training points and GPs. Internal to core/vdb_gpdf*.
+#pragma once
+
+#include "core/gp.hpp"
+#include "core/marching_cubes.hpp"
+#include "core/parallel.hpp"
+#include "core/vdb_gpdf.hpp"
+#include "core/vdb_gpdf/depth_view.hpp"
+
+#include <Eigen/Geometry>
+#include <openvdb/openvdb.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace sonomap::gpdf {
+
+// The centre of voxel ijk of a grid of `voxel` metres, and of the leaf at `origin`.
+inline Eigen::Vector3d voxel_centre(const openvdb::Coord& ijk, double voxel) {
+  return Eigen::Vector3d(ijk.x() + 0.5, ijk.y() + 0.5, ijk.z() + 0.5) * voxel;
+}
+
+inline Eigen::Vector3d leaf_centre(const openvdb::Coord& origin, double voxel) {
+  return (Eigen::Vector3d(origin.x(), origin.y(), origin.z()) + Eigen::Vector3d::Constant(kLeafDim * 0.5)) *
+         voxel;
+}
+
+// The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
+// one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
+// of its 26 neighbours; else the nearest of all (rare: points far from every surface).
+struct LocalGps {
+  double voxel = 0.02;
+  std::vector<openvdb::Coord> origins;
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<Eigen::AlignedBox3d> bounds;  // of each GP's training points
+  std::vector<SurfaceGp> gps;
+  // Per leaf, at one voxel per leaf, its index (-1 where no leaf is): a tree, not a hash map,
+  // because an accessor finds the 26 neighbours of a leaf mostly in the node it has cached.
+  openvdb::Int32Tree index{-1};
+  using IndexAccessor = openvdb::tree::ValueAccessor<const openvdb::Int32Tree, false>;  // unregistered: per call
+  std::vector<std::vector<int>> neighbours;  // per leaf, its neighbouring leaves (of 26)
+
+  // Once every leaf is indexed: most queries lie in a leaf, and then smallest() reads its
+  // neighbours from here instead of 26 lookups.
+  void link_neighbours() {
+    neighbours.assign(origins.size(), {});
+    parallel_for_each_index(origins.size(), [&](size_t i) {
+      IndexAccessor at(index);
+      for_each_neighbour(at, origins[i], [&](int j) { neighbours[i].push_back(j); });
+    });
+  }
+
+  // Calls f(index) for every leaf among the 26 around the leaf at `home`, in x, y, z order. When
+  // all 27 keys lie in one node of the index (two keys in five), they are read from its values:
+  // through the accessor a key cost about 57 instructions.
+  template <typename F>
+  void for_each_neighbour(const IndexAccessor& at, const openvdb::Coord& home, F&& f) const {
+    using IndexNode = openvdb::Int32Tree::LeafNodeType;
+    const openvdb::Coord key = leaf_key_of(home);
+    constexpr int kNodeOrigin = ~static_cast<int>(IndexNode::DIM - 1);  // a key's bits of its node's origin
+    const bool one_node = (key.offsetBy(-1) & kNodeOrigin) == (key.offsetBy(1) & kNodeOrigin);
+    const IndexNode* node = one_node ? at.probeConstLeaf(key) : nullptr;
+    const int* values = node ? node->buffer().data() : nullptr;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const openvdb::Coord k = key.offsetBy(dx, dy, dz);
+          const int i = values ? values[IndexNode::coordToOffset(k)] : at.getValue(k);
+          if (i >= 0) f(i);
+        }
+  }
+
+  // The leaves around q's own leaf: linked already when that leaf exists, else looked up
+  // here once (a quarter of a frame's queries, those between the frame's surfaces, used to
+  // look them up twice: 26 hash look-ups for the nearest leaf, 26 more for the rest).
+  struct Around {
+    const int* begin = nullptr;
+    const int* end = nullptr;
+    std::array<int, 26> found{};
+  };
+
+  // The nearest leaf to q (its own, else the nearest around it, else the nearest of all; ties
+  // to the lower index) and the leaves around q's.
+  int nearest(const Eigen::Vector3d& q, Around& around) const {
+    const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
+    const IndexAccessor at(index);
+    if (const int own = at.getValue(leaf_key_of(home)); own >= 0) {
+      around.begin = neighbours[own].data();
+      around.end = around.begin + neighbours[own].size();
+      return own;
+    }
+    int* next = around.found.data();
+    for_each_neighbour(at, home, [&](int j) { *next++ = j; });
+    around.begin = around.found.data();
+    around.end = next;
+    int best = -1;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    auto consider = [&](int i) {
+      const double d2 = (centres[i] - q).squaredNorm();
+      if (d2 < best_d2 || (d2 == best_d2 && i < best)) {
+        best_d2 = d2;
+        best = i;
+      }
+    };
+    std::for_each(around.begin, around.end, consider);
+    if (best >= 0) return best;
+    for (int i = 0; i < static_cast<int>(centres.size()); ++i) consider(i);
+    return best;
+  }
+
+  // The smallest distance the local GPs predict at q. Each GP knows only its own patch, so its
+  // distance is an upper bound: a surface just across a leaf border is invisible to the
+  // nearest leaf's GP, which then calls a voxel beside a box's edge several centimetres deep
+  // in free space and the edge is carved off. Besides the nearest GP, every leaf around q's
+  // whose training points' box is nearer than the best distance so far (the box, not the
+  // leaf's cube: most neighbours are then skipped unasked).
+  GpPrediction smallest(const Eigen::Vector3d& q, bool with_variance) const {
+    GpPrediction best;
+    auto consider = [&](int i) {
+      const GpPrediction p = gps[i].predict(q, with_variance, false);
+      if (p.valid && (!best.valid || p.distance < best.distance)) best = p;
+    };
+    Around around;
+    const int first = nearest(q, around);
+    if (first < 0) return best;
+    consider(first);
+    for (const int* i = around.begin; i != around.end; ++i)
+      if (*i != first && (!best.valid || bounds[*i].exteriorDistance(q) < best.distance)) consider(*i);
+    return best;
+  }
+};
+
+// Per local voxel: the sum of the frame's points in it (x, y, z) and their count (w).
+using PointSumGrid = openvdb::Grid<openvdb::tree::Tree4<openvdb::Vec4f, 5, 4, 3>::Type>;
+
+// One local leaf's occupied local voxels (centroid and the global voxel holding it) in the
+// order of its mask, the global voxels holding its GP training points, and per local voxel
+// its cell's index (-1: no point fell in it).
+struct LeafCells {
+  using Leaf = PointSumGrid::TreeType::LeafNodeType;
+  struct Cell {
+    Eigen::Vector3d centroid;
+    openvdb::Coord global;
+  };
+  std::vector<Cell> cells;
+  Eigen::AlignedBox3d box;  // of the cells' centroids, in a cloud's frame (empty in an image's)
+  std::vector<openvdb::Coord> trained;
+  std::array<int16_t, Leaf::SIZE> cell_of{};  // 1 kB a leaf: no bit counting per probe
+};
+
+// The frame on the fine local grid: per local voxel the sum of its points, per local leaf its
+// cells, its GP training points and (after train_local_gps) its GP, and the global voxels near
+// the frame's surface.
+struct LocalFrame {
+  PointSumGrid points{openvdb::Vec4f(0.0f)};
+  LocalGps gps;
+  std::vector<LeafCells> cells;
+  std::vector<std::vector<Eigen::Vector3f>> training;
+  // Per local leaf the points queries are placed around: its training points, and one
+  // centroid in every global voxel holding frame points in kMinSparseCells local voxels or
+  // more but no training point (a far surface, a pixel per local voxel, would otherwise be
+  // fused in patches).
+  std::vector<std::vector<Eigen::Vector3f>> sources;
+  openvdb::MaskGrid near{false};
+};
+
+// Stage "voxelise": the frame's points into `out` (points, cells, training points, sources,
+// the global voxels near the surface).
+void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out);
+
+// Stage "local_gps": one GP per local leaf, trained in parallel (each writes its own slot).
+void train_local_gps(const GpParams& params, LocalFrame& local);
+
+}  // namespace sonomap::gpdf
