@@ -69,6 +69,7 @@ void timed(StageTimes& times, const char* name, Stage&& stage) {
   stage();
   times.stages.emplace_back(name, ms_since(t0));
 }
+
 }  // namespace
 
 // A global leaf's GP over its zero crossings, trained at the first query that needs it.

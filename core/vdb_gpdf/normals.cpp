@@ -105,6 +105,7 @@ PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
   return {n.dot(u) < 0.0 ? Eigen::Vector3d(-n) : n, eig.eigenvalues()[1] < kLineSpread * eig.eigenvalues()[2],
           eig.eigenvectors().col(2).normalized()};
 }
+
 // Whether a fit is what one ring's points give: a line, or a plane that the line of sight runs
 // along (within kMinNormalDotRay), the ring's own scan plane through the sensor. A ring lies in
 // that plane whatever the surface, and a depth camera's quantised depth spreads an image row's
@@ -115,6 +116,7 @@ PlaneFit fit_plane(const Scatter& s, const Eigen::Vector3d& u) {
 bool of_one_ring(const PlaneFit& fit, const Eigen::Vector3d& u) {
   return fit.line || (!fit.normal.isZero() && !(fit.normal.dot(u) > kMinNormalDotRay));
 }
+
 }  // namespace
 
 // The surface normal at p facing the sensor (u: unit vector from p toward it), by PCA over the

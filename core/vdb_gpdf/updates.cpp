@@ -158,6 +158,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   out.seen_inside = out.hit && out.distance > 0.0f && arrival();
   return true;
 }
+
 }  // namespace
 
 std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,

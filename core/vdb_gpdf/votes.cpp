@@ -319,6 +319,7 @@ void mark_lone_inside_beside_rays(const VoteGrid& counts, const DistanceWeightGr
   for (const auto& coords : found)
     for (const openvdb::Coord& n : coords) mask.setValueOn(n);
 }
+
 }  // namespace
 
 void cast_votes(const VdbGpdfConfig& config, const LocalFrame& local, const DepthView& view,
