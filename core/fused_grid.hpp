@@ -4,6 +4,7 @@
 // per-leaf samples for the rasters (refreshed only where a frame touched) and as a mesh.
 #pragma once
 
+#include "core/mapper.hpp"
 #include "core/marching_cubes.hpp"
 
 #include <Eigen/Core>
@@ -53,6 +54,32 @@ class FusedGrid {
   float weight_cap_;
   DistanceWeightGrid::Ptr grid_;
   SurfaceCache cache_;
+};
+
+// A map that fuses into a FusedGrid (the TSDF peer, VDB-GPDF): its surface samples and mesh
+// are the grid's.
+class FusedGridMapper : public Mapper {
+ public:
+  void surface_points(const Eigen::Vector3d& center, double radius,
+                      std::vector<Eigen::Vector3f>& out) const override {
+    fused_.surface_points(center, radius, out);
+  }
+  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                              double z_max, std::vector<Eigen::Vector3f>& out) const override {
+    fused_.surface_points_in_band(center, radius, z_min, z_max, out);
+  }
+  void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
+                    std::vector<Eigen::Vector3i>& triangles) const override {
+    fused_.surface_mesh(vertices, triangles);
+  }
+  // The fused grid: x = signed distance (background kUnobservedDistance), y = weight (0).
+  const DistanceWeightGrid& grid() const { return fused_.grid(); }
+
+ protected:
+  FusedGridMapper(double voxel, float min_weight, double weight_cap)
+      : fused_(voxel, min_weight, weight_cap) {}
+
+  FusedGrid fused_;
 };
 
 }  // namespace sonomap

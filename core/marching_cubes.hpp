@@ -61,6 +61,16 @@ inline openvdb::Coord voxel_of(const Eigen::Vector3d& p, double voxel_size) {
                         static_cast<int>(std::floor(p.z() / voxel_size)));
 }
 
+// The centre of voxel ijk of a grid of `voxel_size` metres, and of the leaf at `origin`.
+inline Eigen::Vector3d voxel_centre(const openvdb::Coord& ijk, double voxel_size) {
+  return Eigen::Vector3d(ijk.x() + 0.5, ijk.y() + 0.5, ijk.z() + 0.5) * voxel_size;
+}
+
+inline Eigen::Vector3d leaf_centre(const openvdb::Coord& origin, double voxel_size) {
+  return (Eigen::Vector3d(origin.x(), origin.y(), origin.z()) + Eigen::Vector3d::Constant(kLeafDim * 0.5)) *
+         voxel_size;
+}
+
 // Appends the triangles of the cubes whose lowest corner lies in the leaf at leaf_origin.
 // Vertices shared by cubes of this leaf are not duplicated.
 void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& leaf_origin,

@@ -179,8 +179,8 @@ void TsdfConfig::validate() const {
 }
 
 Tsdf::Tsdf(TsdfConfig config)
-    : config_(validated(config)),
-      fused_(config.voxel, static_cast<float>(config.min_weight), config.weight_cap) {}
+    : FusedGridMapper(validated(config).voxel, static_cast<float>(config.min_weight), config.weight_cap),
+      config_(config) {}
 
 void Tsdf::integrate(const Frame& frame) {
   check_pose(frame);
@@ -254,8 +254,7 @@ std::vector<LeafChanges> Tsdf::integrate_rays(const Frame& frame) {
     openvdb::math::DDA<Ray, 0> dda(ray);
     do {
       const openvdb::Coord ijk = dda.voxel();
-      const Eigen::Vector3d centre = Eigen::Vector3d(ijk.x() + 0.5, ijk.y() + 0.5, ijk.z() + 0.5) * voxel;
-      const double sdf = (centre - origin).norm() - depth;  // positive behind the surface
+      const double sdf = (voxel_centre(ijk, voxel) - origin).norm() - depth;  // positive behind the surface
       if (sdf >= trunc) continue;
       const float tsdf = static_cast<float>(std::max(sdf, -trunc));
       acc.setValue(ijk, fused_.weighted_average(acc.getValue(ijk), openvdb::Vec2s(tsdf, 1.0f)));
@@ -265,16 +264,6 @@ std::vector<LeafChanges> Tsdf::integrate_rays(const Frame& frame) {
   std::vector<LeafChanges> changed = leaf_changes(touched);
   times_.stages.emplace_back("integrate", ms_since(t0));
   return changed;
-}
-
-void Tsdf::surface_points(const Eigen::Vector3d& center, double radius,
-                          std::vector<Eigen::Vector3f>& out) const {
-  fused_.surface_points(center, radius, out);
-}
-
-void Tsdf::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
-                                 double z_max, std::vector<Eigen::Vector3f>& out) const {
-  fused_.surface_points_in_band(center, radius, z_min, z_max, out);
 }
 
 DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
@@ -309,11 +298,6 @@ void Tsdf::query(const std::vector<Eigen::Vector3f>& points,
                  std::vector<DistanceQuery>& out) const {
   out.assign(points.size(), DistanceQuery{});
   parallel_for_each_index(points.size(), [&](size_t i) { out[i] = query_point(points[i]); });
-}
-
-void Tsdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
-                        std::vector<Eigen::Vector3i>& triangles) const {
-  fused_.surface_mesh(vertices, triangles);
 }
 
 size_t Tsdf::memory_bytes() const {

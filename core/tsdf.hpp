@@ -38,26 +38,19 @@ struct TsdfConfig {
   void validate() const;  // std::invalid_argument on a value out of range
 };
 
-class Tsdf final : public Mapper {
+class Tsdf final : public FusedGridMapper {
  public:
   explicit Tsdf(TsdfConfig config = {});
   std::string name() const override { return "tsdf"; }
   void integrate(const Frame& frame) override;
-  void surface_points(const Eigen::Vector3d& center, double radius,
-                      std::vector<Eigen::Vector3f>& out) const override;
-  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
-                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
   // |TSDF| by trilinear interpolation (at most the truncation), gradient from its derivative;
   // observed only where all 8 neighbouring voxels were.
   void query(const std::vector<Eigen::Vector3f>& points,
              std::vector<DistanceQuery>& out) const override;
   StageTimes last_stage_times() const override { return times_; }
-  void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
-                    std::vector<Eigen::Vector3i>& triangles) const override;
   size_t memory_bytes() const override;
 
   const TsdfConfig& config() const { return config_; }
-  const DistanceWeightGrid& grid() const { return fused_.grid(); }
   DistanceQuery query_point(const Eigen::Vector3f& x) const;
 
  private:
@@ -66,7 +59,6 @@ class Tsdf final : public Mapper {
   std::vector<LeafChanges> integrate_rays(const Frame& frame);
 
   TsdfConfig config_;
-  FusedGrid fused_;
   StageTimes times_;
   // Per-frame scratch, kept to spare the allocations: the range-limited depth image, and the
   // leaves a frame updates (one voxel per leaf, at leaf origin / 8; all off between frames).

@@ -129,8 +129,9 @@ double carving_frame_bound(double weight_cap, double d_old, double carve) {
 }
 
 VdbGpdf::VdbGpdf(VdbGpdfConfig config)
-    : config_(validated(config)),
-      fused_(config.global_voxel, static_cast<float>(config.recon_min_weight), config.weight_cap) {}
+    : FusedGridMapper(validated(config).global_voxel, static_cast<float>(config.recon_min_weight),
+                      config.weight_cap),
+      config_(config) {}
 
 VdbGpdf::~VdbGpdf() = default;
 
@@ -168,20 +169,10 @@ void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
       continue;
     }
     auto leaf = std::make_unique<GlobalLeaf>();
-    leaf->centre = gpdf::leaf_centre(dirty[i], config_.global_voxel);
+    leaf->centre = leaf_centre(dirty[i], config_.global_voxel);
     leaf->crossings = std::move(meshes[i].vertices);
     global_[dirty[i]] = std::move(leaf);
   }
-}
-
-void VdbGpdf::surface_points(const Eigen::Vector3d& center, double radius,
-                             std::vector<Eigen::Vector3f>& out) const {
-  fused_.surface_points(center, radius, out);
-}
-
-void VdbGpdf::surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
-                                    double z_max, std::vector<Eigen::Vector3f>& out) const {
-  fused_.surface_points_in_band(center, radius, z_min, z_max, out);
 }
 
 DistanceQuery VdbGpdf::query_point(const Eigen::Vector3f& xf) const {
@@ -273,11 +264,6 @@ void VdbGpdf::query(const std::vector<Eigen::Vector3f>& points,
                     std::vector<DistanceQuery>& out) const {
   out.assign(points.size(), DistanceQuery{});
   parallel_for_each_index(points.size(), [&](size_t i) { out[i] = query_point(points[i]); });
-}
-
-void VdbGpdf::surface_mesh(std::vector<Eigen::Vector3f>& vertices,
-                           std::vector<Eigen::Vector3i>& triangles) const {
-  fused_.surface_mesh(vertices, triangles);
 }
 
 size_t VdbGpdf::memory_bytes() const {

@@ -58,27 +58,19 @@ struct VdbGpdfConfig {
 // d_old r^k - carve (1 - r^k) < 0, r = cap / (cap + 1). Infinite without a cap.
 double carving_frame_bound(double weight_cap, double d_old, double carve);
 
-class VdbGpdf final : public Mapper {
+class VdbGpdf final : public FusedGridMapper {
  public:
   explicit VdbGpdf(VdbGpdfConfig config = {});
   ~VdbGpdf() override;
   std::string name() const override { return "vdb_gpdf"; }
   void integrate(const Frame& frame) override;
-  void surface_points(const Eigen::Vector3d& center, double radius,
-                      std::vector<Eigen::Vector3f>& out) const override;
-  void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
-                              double z_max, std::vector<Eigen::Vector3f>& out) const override;
   // Unsigned distance from the global field (smooth minimum over the nearest global GPs).
   void query(const std::vector<Eigen::Vector3f>& points,
              std::vector<DistanceQuery>& out) const override;
   StageTimes last_stage_times() const override { return times_; }
-  void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
-                    std::vector<Eigen::Vector3i>& triangles) const override;
   size_t memory_bytes() const override;
 
   const VdbGpdfConfig& config() const { return config_; }
-  // The fused global grid: x = signed distance (background -100), y = weight (background 0).
-  const DistanceWeightGrid& grid() const { return fused_.grid(); }
   size_t global_gp_count() const { return global_.size(); }
   DistanceQuery query_point(const Eigen::Vector3f& x) const;
 
@@ -92,7 +84,6 @@ class VdbGpdf final : public Mapper {
                                          const std::vector<const GlobalLeaf*>& leaves) const;
 
   VdbGpdfConfig config_;
-  FusedGrid fused_;
   std::unordered_map<openvdb::Coord, std::unique_ptr<GlobalLeaf>, CoordHash> global_;
   StageTimes times_;
 };

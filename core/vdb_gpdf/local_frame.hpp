@@ -18,16 +18,6 @@
 
 namespace sonomap::gpdf {
 
-// The centre of voxel ijk of a grid of `voxel` metres, and of the leaf at `origin`.
-inline Eigen::Vector3d voxel_centre(const openvdb::Coord& ijk, double voxel) {
-  return Eigen::Vector3d(ijk.x() + 0.5, ijk.y() + 0.5, ijk.z() + 0.5) * voxel;
-}
-
-inline Eigen::Vector3d leaf_centre(const openvdb::Coord& origin, double voxel) {
-  return (Eigen::Vector3d(origin.x(), origin.y(), origin.z()) + Eigen::Vector3d::Constant(kLeafDim * 0.5)) *
-         voxel;
-}
-
 // The frame's local GPs, one per active leaf of the local grid, and the lookup of the nearest
 // one: cubic leaves are their own Voronoi cells, so the containing leaf wins; else the nearest
 // of its 26 neighbours; else the nearest of all (rare: points far from every surface).
