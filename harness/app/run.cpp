@@ -202,6 +202,7 @@ std::string summary_screen(const RunOutcome& outcome) {
   text += fmt::format("  results: {}\n", outcome.dir.string());
   return text;
 }
+
 void add_run_command(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand(
