@@ -72,6 +72,8 @@ class FusedGridMapper : public Mapper {
                     std::vector<Eigen::Vector3i>& triangles) const override {
     fused_.surface_mesh(vertices, triangles);
   }
+  // The fused grid's bytes; a map that holds more adds its own.
+  size_t memory_bytes() const override { return fused_.memory_bytes(); }
   // The fused grid: x = signed distance (background kUnobservedDistance), y = weight (0).
   const DistanceWeightGrid& grid() const { return fused_.grid(); }
 

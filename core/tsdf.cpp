@@ -173,7 +173,9 @@ void TsdfConfig::validate() const {
   if (!positive(voxel)) fail("voxel must be > 0, got " + std::to_string(voxel));
   if (!positive(truncation)) fail("truncation must be > 0, got " + std::to_string(truncation));
   if (!(weight_cap >= 0.0)) fail("weight_cap must be >= 0 (0 = no cap)");
-  if (!(min_weight >= 0.0) || !std::isfinite(min_weight)) fail("min_weight must be >= 0");
+  // Held as a float by the grid: a larger value would become infinity there.
+  if (!(min_weight >= 0.0 && min_weight <= std::numeric_limits<float>::max()))
+    fail("min_weight must be >= 0 and a finite float");
   if (!(min_range >= 0.0 && positive(max_range) && min_range < max_range))
     fail("need 0 <= min_range < max_range");
 }
@@ -298,10 +300,6 @@ void Tsdf::query(const std::vector<Eigen::Vector3f>& points,
                  std::vector<DistanceQuery>& out) const {
   out.assign(points.size(), DistanceQuery{});
   parallel_for_each_index(points.size(), [&](size_t i) { out[i] = query_point(points[i]); });
-}
-
-size_t Tsdf::memory_bytes() const {
-  return fused_.memory_bytes();
 }
 
 }  // namespace sonomap

@@ -48,7 +48,6 @@ class Tsdf final : public FusedGridMapper {
   void query(const std::vector<Eigen::Vector3f>& points,
              std::vector<DistanceQuery>& out) const override;
   StageTimes last_stage_times() const override { return times_; }
-  size_t memory_bytes() const override;
 
   const TsdfConfig& config() const { return config_; }
   DistanceQuery query_point(const Eigen::Vector3f& x) const;

@@ -98,8 +98,8 @@ void VdbGpdfConfig::validate() const {
   require(global_neighbours >= 1, "global_neighbours must be >= 1");
   require(positive(query_radius), "query_radius must be > 0");
   require(positive(gradient_scale), "gradient_scale must be > 0");
-  require(recon_min_weight >= 0.0 && std::isfinite(recon_min_weight),
-          "recon_min_weight must be >= 0");
+  require(recon_min_weight >= 0.0 && recon_min_weight <= std::numeric_limits<float>::max(),
+          "recon_min_weight must be >= 0 and a finite float");  // the grid holds it as a float
   require(min_range >= 0.0 && positive(max_range) && min_range < max_range,
           "need 0 <= min_range < max_range");
 }
@@ -267,7 +267,7 @@ void VdbGpdf::query(const std::vector<Eigen::Vector3f>& points,
 }
 
 size_t VdbGpdf::memory_bytes() const {
-  size_t bytes = fused_.memory_bytes();
+  size_t bytes = FusedGridMapper::memory_bytes();
   for (const auto& kv : global_) {
     const size_t n = kv.second->crossings.size();
     bytes += sizeof(GlobalLeaf) + n * sizeof(Eigen::Vector3f);

@@ -98,6 +98,9 @@ TEST_CASE("TSDF: deterministic, and bad input rejected without touching the map"
   bad = TsdfConfig{};
   bad.truncation = -1.0;
   CHECK_THROWS_AS(Tsdf(bad), std::invalid_argument);
+  bad = TsdfConfig{};
+  bad.min_weight = 1e300;  // finite as a double, infinite as the grid's float
+  CHECK_THROWS_AS(Tsdf(bad), std::invalid_argument);
 }
 
 TEST_CASE("TSDF: 1 and 2 threads give the same map, voxel for voxel", "[tsdf][determinism]") {

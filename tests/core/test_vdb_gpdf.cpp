@@ -255,6 +255,9 @@ TEST_CASE("VDB-GPDF: bad input is rejected or skipped, never fused", "[vdb_gpdf]
   bad = VdbGpdfConfig{};
   bad.lambda = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(VdbGpdf(bad), std::invalid_argument);
+  bad = VdbGpdfConfig{};
+  bad.recon_min_weight = 1e300;  // finite as a double, infinite as the grid's float
+  CHECK_THROWS_AS(VdbGpdf(bad), std::invalid_argument);
   // Queries at non-finite points read "unobserved", not a guess.
   std::vector<DistanceQuery> q;
   dirty.query({Eigen::Vector3f(std::nanf(""), 0.f, 0.f)}, q);
