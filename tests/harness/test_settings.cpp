@@ -13,7 +13,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <regex>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -189,6 +188,19 @@ TEST_CASE("command line numbers: --voxel 0, a keyframe at 1e300 and --near-below
   CHECK(sonify.output.find("--near-below") != std::string::npos);
 }
 
+// Whether `text` says "about <number> GiB" (digits, '.', 'e' or '+'). Not std::regex: GCC 12
+// warns of uninitialised members inside its regex compiler under -fsanitize (a false alarm).
+namespace {
+bool states_gib_estimate(const std::string& text) {
+  for (size_t at = text.find("about "); at != std::string::npos; at = text.find("about ", at + 1)) {
+    const size_t number = at + 6;
+    const size_t end = text.find_first_not_of("0123456789.e+", number);
+    if (end != number && end != std::string::npos && text.compare(end, 4, " GiB") == 0) return true;
+  }
+  return false;
+}
+}  // namespace
+
 TEST_CASE("a voxel whose map would exceed --max-memory is refused before any work, with the estimate",
           "[settings][bounds][cli]") {
   ScratchDir scratch("settings-memory");
@@ -197,7 +209,7 @@ TEST_CASE("a voxel whose map would exceed --max-memory is refused before any wor
                               "--out", out.string(), "--voxel", "0.001", "--max-memory", "1"});
   INFO(r.output);
   CHECK(r.status == 2);
-  CHECK(std::regex_search(r.output, std::regex("about [0-9.e+]+ GiB")));
+  CHECK(states_gib_estimate(r.output));
   CHECK(r.output.find("--max-memory") != std::string::npos);
   CHECK(sonomap::test::nothing_written(out));
 }
