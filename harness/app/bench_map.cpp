@@ -45,6 +45,7 @@ using nlohmann::json;
 // The reference: the `open3d` mapper (Open3D's ScalableTSDFVolume, with the TSDF peer's voxel
 // and truncation), run like every other mapper; its ratios use its fusion time ("map").
 constexpr const char* kOpen3d = "open3d";
+constexpr int kMaxWarmup = 1000;
 const TsdfConfig kPeer;  // the open3d mapper's defaults (voxel, truncation, ranges) are the TSDF peer's
 
 struct BenchMapOptions {
@@ -52,6 +53,8 @@ struct BenchMapOptions {
   int frames = 60;
   // Room: the listener turns once in 30 s (900 frames), so 60 frames 15 apart see every side.
   int every = 15;
+  // Frames integrated untimed before each (voxel, threads) group (warm_up).
+  int warmup = 10;
   std::vector<double> voxels{0.05, 0.10, 0.15};
   std::vector<int> threads{1, 2};
   std::vector<std::string> mappers{"vdb_gpdf", "tsdf", kOpen3d};
@@ -162,6 +165,8 @@ constexpr int kMaxRowStep = 100000;
 void check_options(const BenchMapOptions& o) {
   if (o.frames < 1) throw InputError("--frames must be at least 1, got " + std::to_string(o.frames));
   if (o.every < 1) throw InputError("--every must be at least 1, got " + std::to_string(o.every));
+  if (o.warmup < 0 || o.warmup > kMaxWarmup)
+    throw InputError(fmt::format("--warmup must be in [0, {}], got {}", kMaxWarmup, o.warmup));
   if (o.voxels.empty() || o.threads.empty() || o.mappers.empty())
     throw InputError("--voxels, --threads-list and --mappers each need at least one value");
   for (double v : o.voxels)
@@ -228,36 +233,64 @@ std::optional<ReferenceCheck> reference_check(const std::vector<Frame>& frames, 
                         median_nearest_distance(open3d_vertices, tsdf_surface)};
 }
 
+std::vector<std::unique_ptr<TimedMap>> make_maps(const std::vector<std::string>& mappers, double voxel,
+                                                 const sim::Scenario& scenario) {
+  std::vector<std::unique_ptr<TimedMap>> maps;
+  for (const std::string& name : mappers)
+    maps.push_back(std::make_unique<TimedMap>(make_mapper(name, voxel, {}), scenario.ground_z));
+  return maps;
+}
+
+void process_frame(TimedMap& map, const Frame& frame, StageList& stages) {
+  stages.clear();
+  try {
+    map.process(frame, stages);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
+  }
+}
+
+// The first `count` frames through fresh maps of the group's mappers, untimed and then dropped.
+// A process's first frames pay for first touches of its heap and its worker threads' arenas,
+// which a long run pays once: without this the first group of a bench read 25-35% slower than
+// the same group run again (docs/performance.md, "Warm-up").
+void warm_up(const std::vector<Frame>& frames, size_t count, const sim::Scenario& scenario, double voxel,
+             const std::vector<std::string>& mappers, Progress& progress, long& done) {
+  std::vector<std::unique_ptr<TimedMap>> maps = make_maps(mappers, voxel, scenario);
+  StageList stages;
+  for (size_t i = 0; i < std::min(count, frames.size()); ++i)
+    for (auto& map : maps) {
+      process_frame(*map, frames[i], stages);
+      progress.update(++done);
+    }
+}
+
 // One (voxel, threads) group: every mapper integrates frame i before any integrates frame i + 1,
 // so a change in the machine's load hits all of them alike and their ratios stay fair.
 std::vector<CellResult> time_group(const std::vector<Frame>& frames, const sim::Scenario& scenario,
                                    double voxel, int threads, const std::vector<std::string>& mappers,
-                                   Progress& progress, long& done, std::optional<ReferenceCheck>& check) {
+                                   size_t warmup, Progress& progress, long& done,
+                                   std::optional<ReferenceCheck>& check) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   // Open3D's own OpenMP loops: their num_threads() clause follows omp_get_max_threads() only
   // when OMP_NUM_THREADS is set (otherwise they take every core), so set both.
   setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   omp_set_num_threads(threads);
   const int active = static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  warm_up(frames, warmup, scenario, voxel, mappers, progress, done);
   std::vector<CellResult> cells(mappers.size());
-  std::vector<std::unique_ptr<TimedMap>> maps;
   for (size_t m = 0; m < mappers.size(); ++m) {
     cells[m].voxel = voxel;
     cells[m].threads = active;
     cells[m].mapper = mappers[m];
-    maps.push_back(std::make_unique<TimedMap>(make_mapper(mappers[m], voxel, {}), scenario.ground_z));
   }
+  std::vector<std::unique_ptr<TimedMap>> maps = make_maps(mappers, voxel, scenario);
   StageList stages;
   for (const Frame& frame : frames)
     for (size_t m = 0; m < mappers.size(); ++m) {
       CellResult& cell = cells[m];
-      stages.clear();
       const double cpu_start = process_cpu_ms();
-      try {
-        maps[m]->process(frame, stages);
-      } catch (const std::invalid_argument& e) {
-        throw InputError(fmt::format("frame {}: {}", frame.index, e.what()));
-      }
+      process_frame(*maps[m], frame, stages);
       cell.frame_cpu_ms.push_back(process_cpu_ms() - cpu_start);
       for (const auto& [name, ms] : stages) {
         if (!cell.samples.count(name)) cell.stage_order.push_back(name);
@@ -315,6 +348,7 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
            {"code_version", code_version()},
            {"frames", json::array()},
            {"every", o.every},
+           {"warmup_frames_per_group", std::min<size_t>(o.warmup, frames.size())},
            {"camera", {{"width", scenario.camera.width}, {"height", scenario.camera.height}}},
            {"input", {{"kind", o.input},
                       {"row_step", o.row_step},
@@ -376,7 +410,8 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   }
   const long available = std::min<long>(o.frames, (scenario.frames - 1) / o.every + 1);
   const long cells = static_cast<long>(o.voxels.size() * o.threads.size() * o.mappers.size());
-  Progress progress("bench map", available * (1 + cells), global.quiet);
+  const long warmup = std::min<long>(o.warmup, available);
+  Progress progress("bench map", available * (1 + cells) + warmup * cells, global.quiet);
   long done = 0;
   const std::vector<Frame> frames = render_frames(scenario, o, progress, done);
   const double rss_frames_mb = process_peak_rss_mb();
@@ -387,7 +422,8 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   for (double voxel : o.voxels)
     for (int threads : o.threads) {
       std::optional<ReferenceCheck> check;
-      for (CellResult& cell : time_group(frames, scenario, voxel, threads, o.mappers, progress, done, check))
+      for (CellResult& cell : time_group(frames, scenario, voxel, threads, o.mappers,
+                                         static_cast<size_t>(warmup), progress, done, check))
         results.push_back(std::move(cell));
       if (check) checks.push_back(*check);
     }
@@ -405,6 +441,8 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), {} loops, medians per frame in ms\n",
              scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every,
              name_of(vector_isa()));
+  fmt::print("each (voxel, threads) group timed after its first {} frames through fresh maps, untimed "
+             "(--warmup)\n", warmup);
   fmt::print("input: {}\n", input.text);
   fmt::print("map = the mapper's integrate (open3d: depth copy + Integrate, truncation {:g} voxels); "
              "raster = circle + cylinder\nfrom the map's surface samples (as `run`; open3d: mesh "
@@ -460,6 +498,11 @@ void add_bench_map(CLI::App& bench, const GlobalOptions& global) {
   cmd->add_option("scenario", options->scenario, "Scenario YAML")->capture_default_str();
   cmd->add_option("--frames", options->frames, "Frames to integrate and time")->capture_default_str();
   cmd->add_option("--every", options->every, "Take every K-th frame of the scenario (from frame 0)")
+      ->capture_default_str();
+  cmd->add_option("--warmup", options->warmup,
+                  fmt::format("Frames integrated untimed by fresh maps before each (voxel, threads) "
+                              "group, so that none pays the process's first touches of memory "
+                              "(0-{})", kMaxWarmup))
       ->capture_default_str();
   cmd->add_option("--voxels", options->voxels, "Voxel sizes in metres")
       ->delimiter(',')->capture_default_str();

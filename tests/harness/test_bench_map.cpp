@@ -70,6 +70,8 @@ TEST_CASE("bench map times every stage of every mapper and Open3D's surface agre
   CHECK(check.at("open3d_vertices").get<int>() > 1000);
   CHECK(check.at("median_distance_m").get<double>() < 0.1);
   CHECK(bench.at("peak_rss_mb").get<double>() > 0.0);
+  // Every group was warmed up on its first frames (the default 10, of the 3 there are).
+  CHECK(bench.at("warmup_frames_per_group").get<int>() == 3);
   // The instruction set of the vectorised loops, which the figures depend on.
   CHECK(std::set<std::string>{"baseline", "AVX2", "AVX-512"}.count(bench.at("vector_loops")) == 1);
 }
@@ -101,7 +103,7 @@ TEST_CASE("bench map reports what a coarser voxel and a second thread change, pe
   CHECK(result.output.find("2 threads are") != std::string::npos);
 }
 
-TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0 and no frames, writing nothing",
+TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0, no frames and a warm-up out of range, writing nothing",
           "[cli][bench]") {
   const sonomap::test::ScratchDir scratch("bench-map-bad");
   const fs::path file = scratch.path() / "bench.json";
@@ -125,6 +127,13 @@ TEST_CASE("bench map rejects an unknown mapper, a voxel size <= 0 and no frames,
   const auto no_frames = with("--frames", "0");
   CHECK(no_frames.status == 2);
   CHECK_THAT(no_frames.output, Catch::Contains("--frames"));
+  for (const std::string warmup : {"-1", "1001"}) {
+    auto arguments = bench_map_arguments(file);
+    arguments.insert(arguments.end(), {"--warmup", warmup});
+    const auto bad_warmup = run_sonomap(arguments);
+    CHECK(bad_warmup.status == 2);
+    CHECK_THAT(bad_warmup.output, Catch::Contains("--warmup must be in [0, 1000], got " + warmup));
+  }
   CHECK(sonomap::test::nothing_written(file));
 }
 
