@@ -252,8 +252,8 @@ void process_frame(TimedMap& map, const Frame& frame, StageList& stages) {
 
 // The first `count` frames through fresh maps of the group's mappers, untimed and then dropped.
 // A process's first frames pay for first touches of its heap and its worker threads' arenas,
-// which a long run pays once: without this the first group of a bench read 25-35% slower than
-// the same group run again (docs/performance.md, "Warm-up").
+// which a long run pays once: without this the first group of a bench read 25-45% slower than
+// the same group run again (docs/performance.md, "Freed memory kept, and every group warmed up").
 void warm_up(const std::vector<Frame>& frames, size_t count, const sim::Scenario& scenario, double voxel,
              const std::vector<std::string>& mappers, Progress& progress, long& done) {
   std::vector<std::unique_ptr<TimedMap>> maps = make_maps(mappers, voxel, scenario);
