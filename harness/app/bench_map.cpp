@@ -441,8 +441,8 @@ void bench_map(const BenchMapOptions& o, const GlobalOptions& global) {
   fmt::print("bench map: '{}', {}x{}, {} frames (every {}-th from 0), {} loops, medians per frame in ms\n",
              scenario.name, scenario.camera.width, scenario.camera.height, frames.size(), o.every,
              name_of(vector_isa()));
-  fmt::print("each (voxel, threads) group timed after its first {} frames through fresh maps, untimed "
-             "(--warmup)\n", warmup);
+  fmt::print("warm-up: the first {} of the frames through fresh maps before each (voxel, threads) group, "
+             "untimed (--warmup)\n", warmup);
   fmt::print("input: {}\n", input.text);
   fmt::print("map = the mapper's integrate (open3d: depth copy + Integrate, truncation {:g} voxels); "
              "raster = circle + cylinder\nfrom the map's surface samples (as `run`; open3d: mesh "
