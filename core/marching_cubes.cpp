@@ -101,7 +101,7 @@ void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, do
                 float min_weight, SurfaceMesh& out) {
   const auto& table = triangle_table();
   std::array<float, kSpan * kSpan * kSpan> dist, weight;
-  DistanceWeightGrid::ConstAccessor acc = grid.getConstAccessor();
+  const auto acc = read_accessor(grid);
   bool any_inside = false, any_outside = false;
   for (int x = 0; x < kSpan; ++x)
     for (int y = 0; y < kSpan; ++y)

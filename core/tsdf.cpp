@@ -276,7 +276,7 @@ DistanceQuery Tsdf::query_point(const Eigen::Vector3f& xf) const {
   const Eigen::Vector3d f = g - base;
   const openvdb::Coord b(static_cast<int>(base.x()), static_cast<int>(base.y()),
                          static_cast<int>(base.z()));
-  auto acc = fused_.grid().getConstAccessor();
+  const auto acc = read_accessor(fused_.grid());
   double d = 0.0;
   Eigen::Vector3d grad = Eigen::Vector3d::Zero();
   for (int c = 0; c < 8; ++c) {

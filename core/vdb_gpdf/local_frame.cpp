@@ -167,7 +167,7 @@ class LocalVoxelsAround {
  public:
   using Leaf = PointSumGrid::TreeType::LeafNodeType;
   LocalVoxelsAround(const PointSumGrid& grid, const Leaf& leaf) : origin_(leaf.origin()) {
-    const auto acc = grid.getConstAccessor();
+    const auto acc = read_accessor(grid);
     const int dim = static_cast<int>(Leaf::DIM);
     for (int i = 0; i < 27; ++i)
       leaves_[i] = acc.probeConstLeaf(origin_.offsetBy((i / 9 - 1) * dim, (i / 3 % 3 - 1) * dim, (i % 3 - 1) * dim));
@@ -329,7 +329,7 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
   local.sources.resize(leaves.size());
   parallel_for_each_index(leaves.size(), [&](size_t i) {
     local.sources[i] = local.training[i];
-    const auto count = counts.getConstAccessor();
+    const auto count = read_accessor(counts);
     for (const auto& cell : leaves[i].cells) {
       const int held = count.getValue(cell.global);
       if (held >= kMinSparseCells || (held >= 1 && view.at_edge(cell.centroid, kEdgePixels)))

@@ -38,9 +38,9 @@ constexpr double kInsideCapVoxels = 0.5;
 // points, its depth image and the map as it was before the frame (one per task: accessors).
 struct UpdateLookups {
   const LocalGps& locals;
-  openvdb::MaskGrid::ConstAccessor near;
+  ReadAccessor<openvdb::MaskGrid> near;
   const DepthView& view;
-  DistanceWeightGrid::ConstAccessor map;
+  ReadAccessor<DistanceWeightGrid> map;
 };
 
 // Whether the surface that `sight`'s pixel measured is new to the map: the map's value at the
@@ -170,9 +170,9 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   votes.counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
   parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
-    const UpdateLookups lookups{local.gps, local.near.getConstAccessor(), view, fused.getConstAccessor()};
-    const auto surface_acc = votes.surface.getConstAccessor();
-    const auto lateral_acc = votes.lateral.getConstAccessor();
+    const UpdateLookups lookups{local.gps, read_accessor(local.near), view, read_accessor(fused)};
+    const auto surface_acc = read_accessor(votes.surface);
+    const auto lateral_acc = read_accessor(votes.lateral);
     QueryUpdate update;
     for (auto v = vote_leaves[i]->cbeginValueOn(); v; ++v) {
       const openvdb::Coord& c = v.getCoord();

@@ -31,7 +31,7 @@ class LeafQueries {
   LeafQueries(const VdbGpdfConfig& config, const LocalFrame& local, const DistanceWeightGrid& fused,
               size_t leaf, const Eigen::Vector3d& origin, const DepthView& view)
       : config_(config), view_(view), gp_(local.gps.gps[leaf]), origin_(origin), vg_(config.global_voxel),
-        lateral_(!view.has_image()), observed_(fused.getConstAccessor()), cells_(local.cells), index_(local.gps.index),
+        lateral_(!view.has_image()), observed_(read_accessor(fused)), cells_(local.cells), index_(local.gps.index),
         wide_{local.cells, local.gps, leaf} {}
 
   std::vector<Vote> votes;
@@ -224,7 +224,7 @@ class LeafQueries {
   Eigen::Vector3d origin_;
   double vg_;
   bool lateral_;
-  DistanceWeightGrid::ConstAccessor observed_;
+  ReadAccessor<DistanceWeightGrid> observed_;
   const std::vector<LeafCells>& cells_;
   LocalGps::IndexAccessor index_;
   WideNeighbourhood wide_;
@@ -294,8 +294,8 @@ void mark_lone_inside_beside_rays(const VoteGrid& counts, const DistanceWeightGr
   counts.tree().getNodes(leaves);
   std::vector<std::vector<openvdb::Coord>> found(leaves.size());
   parallel_for_each_index(leaves.size(), [&](size_t i) {
-    const auto voted = counts.getConstAccessor();
-    const auto map = fused.getConstAccessor();
+    const auto voted = read_accessor(counts);
+    const auto map = read_accessor(fused);
     auto held_inside = [&](const openvdb::Coord& c) {
       openvdb::Vec2s value;
       return map.probeValue(c, value) && value[0] > 0.0f;
