@@ -26,11 +26,11 @@ using DistanceWeightGrid = openvdb::Grid<openvdb::Vec2STree>;
 // took 0.50 ms on one thread and 0.93 ms on two, which contend for the map (these: 0.05 and
 // 0.06 ms). A 5 cm VDB-GPDF frame makes about 2,800, one or more per leaf task
 // (docs/performance.md, "Accessors not registered").
+template <class TreeT>
+using ReadAccessor = openvdb::tree::ValueAccessor<const TreeT, false>;
 template <class GridT>
-using ReadAccessor = openvdb::tree::ValueAccessor<const typename GridT::TreeType, false>;
-template <class GridT>
-ReadAccessor<GridT> read_accessor(const GridT& grid) {
-  return ReadAccessor<GridT>(grid.tree());
+ReadAccessor<typename GridT::TreeType> read_accessor(const GridT& grid) {
+  return ReadAccessor<typename GridT::TreeType>(grid.tree());
 }
 
 struct SurfaceMesh {

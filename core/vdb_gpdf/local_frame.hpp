@@ -30,7 +30,7 @@ struct LocalGps {
   // Per leaf, at one voxel per leaf, its index (-1 where no leaf is): a tree, not a hash map,
   // because an accessor finds the 26 neighbours of a leaf mostly in the node it has cached.
   openvdb::Int32Tree index{-1};
-  using IndexAccessor = openvdb::tree::ValueAccessor<const openvdb::Int32Tree, false>;  // unregistered: per call
+  using IndexAccessor = ReadAccessor<openvdb::Int32Tree>;  // per call
   std::vector<std::vector<int>> neighbours;  // per leaf, its neighbouring leaves (of 26)
 
   // Once every leaf is indexed: most queries lie in a leaf, and then smallest() reads its

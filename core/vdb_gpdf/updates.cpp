@@ -38,9 +38,9 @@ constexpr double kInsideCapVoxels = 0.5;
 // points, its depth image and the map as it was before the frame (one per task: accessors).
 struct UpdateLookups {
   const LocalGps& locals;
-  ReadAccessor<openvdb::MaskGrid> near;
+  ReadAccessor<openvdb::MaskTree> near;
   const DepthView& view;
-  ReadAccessor<DistanceWeightGrid> map;
+  ReadAccessor<DistanceWeightGrid::TreeType> map;
 };
 
 // Whether the surface that `sight`'s pixel measured is new to the map: the map's value at the

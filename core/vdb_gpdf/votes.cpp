@@ -224,7 +224,7 @@ class LeafQueries {
   Eigen::Vector3d origin_;
   double vg_;
   bool lateral_;
-  ReadAccessor<DistanceWeightGrid> observed_;
+  ReadAccessor<DistanceWeightGrid::TreeType> observed_;
   const std::vector<LeafCells>& cells_;
   LocalGps::IndexAccessor index_;
   WideNeighbourhood wide_;
