@@ -369,14 +369,21 @@ void write_json(const BenchMapOptions& o, const sim::Scenario& scenario, const s
            {"rss_after_rendering_mb", rss_frames_mb}};
   for (const Frame& f : frames) out["frames"].push_back(f.index);
   for (const CellResult& c : results) {
-    json stages = json::object();
-    for (const std::string& name : c.stage_order) stages[name] = c.median_of(name);
+    json stages = json::object(), samples = json::object();
+    for (const std::string& name : c.stage_order) {
+      stages[name] = c.median_of(name);
+      samples[name] = c.samples.at(name);
+    }
     out["results"].push_back({{"voxel", c.voxel},
                               {"threads", c.threads},
                               {"mapper", c.mapper},
                               {"frames", c.samples.at("frame").size()},
                               {"median_ms", stages},
                               {"frame_cpu_median_ms", median(c.frame_cpu_ms)},
+                              // Every timed frame's figures, in the order of "frames": for a
+                              // user's own statistics, e.g. two builds compared frame by frame.
+                              {"samples_ms", samples},
+                              {"frame_cpu_ms", c.frame_cpu_ms},
                               {"frame_ratio_to_open3d", number(c.frame_ratio)},
                               {"map_ratio_to_open3d", number(c.map_ratio)},
                               {"peak_map_bytes", c.peak_map_bytes}});

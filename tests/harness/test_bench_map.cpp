@@ -56,7 +56,14 @@ TEST_CASE("bench map times every stage of every mapper and Open3D's surface agre
       INFO("stage " << stage);
       CHECK(std::isfinite(ms.get<double>()));
       CHECK(ms.get<double>() > 0.0);
+      // Every timed frame's time is kept, and the median is the middle one of the three.
+      auto samples = row.at("samples_ms").at(stage).get<std::vector<double>>();
+      REQUIRE(samples.size() == 3);
+      std::sort(samples.begin(), samples.end());
+      CHECK(samples[1] == ms.get<double>());
     }
+    CHECK(row.at("samples_ms").size() == row.at("median_ms").size());
+    CHECK(row.at("frame_cpu_ms").size() == 3);
     // Open3D's fusion is the reference every row is compared with, its own included.
     CHECK(row.at("frame_ratio_to_open3d").get<double>() > 0.0);
     if (mapper == "open3d") CHECK(row.at("map_ratio_to_open3d").get<double>() == 1.0);
