@@ -42,13 +42,14 @@ inline const std::vector<std::string>& small_camera_keys() {
   return keys;
 }
 
-// A depth_only run of `input` (a scenario with `overrides`, or a recording), 6 frames.
+// A run of `input` (a scenario with `overrides`, or a recording), 6 frames, by depth_only
+// unless another mapper is named.
 inline nlohmann::json run_quietly(const std::filesystem::path& input, const std::filesystem::path& out,
-                                  std::vector<std::string> overrides = {}) {
+                                  std::vector<std::string> overrides = {}, const std::string& mapper = "depth_only") {
   harness::RunOptions options;
   options.scenario = input;
   options.out = out;
-  options.mapper = "depth_only";
+  options.mapper = mapper;
   options.frames = 6;
   options.overrides = std::move(overrides);
   options.picture_frames = options.sweep_frames = {-1};
