@@ -166,20 +166,37 @@ void World::set_time(double t) {
 
 namespace {
 
-// 4x4 pixel tiles = one rtcIntersect16 packet: the widest Embree has, native with AVX-512
-// (and two AVX2 halves elsewhere); on the AVX-512 machine of docs/performance.md the rays cost
-// 40% less than with rtcIntersect8 on 4x2 tiles.
-constexpr int kTileW = 4, kTileH = 4, kPacket = kTileW * kTileH;
+// A tile of pixels is one Embree ray packet (World::Packet): 4x4 pixels and rtcIntersect16,
+// native with AVX-512 (on the AVX-512 machine of docs/performance.md 40% less time than
+// rtcIntersect8 on 4x2 tiles), or 4x2 pixels and rtcIntersect8, native with AVX2 (on a Zen 3
+// core, which has no AVX-512, 10% less time than 16-ray packets; 8x1 tiles the same, 2x2 tiles
+// and rtcIntersect4 1.5x).
+struct Tiles16 {
+  static constexpr int kW = 4, kH = 4;
+  using RayHit = RTCRayHit16;
+  static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rays) {
+    rtcIntersect16(valid, scene, context, rays);
+  }
+};
+struct Tiles8 {
+  static constexpr int kW = 4, kH = 2;
+  using RayHit = RTCRayHit8;
+  static void intersect(const int* valid, RTCScene scene, RTCIntersectContext* context, RayHit* rays) {
+    rtcIntersect8(valid, scene, context, rays);
+  }
+};
 
-// One packet of kTileW x kTileH rays: pixel i of the packet is (u0 + i % kTileW, v0 + i / kTileW).
+// One packet of kW x kH rays: pixel i of the packet is (u0 + i % kW, v0 + i / kW).
+template <class Tiles>
 struct Packet {
-  alignas(64) RTCRayHit16 rayhit;
-  alignas(64) int valid[kPacket];  // rtcIntersect16 needs both 64-byte aligned
+  static constexpr int kSize = Tiles::kW * Tiles::kH;
+  alignas(64) typename Tiles::RayHit rayhit;
+  alignas(64) int valid[kSize];  // Embree needs both aligned to the packet's bytes
 
   // The fields no intersection changes, set once: origin, interval start, time, mask, flags.
   explicit Packet(const Eigen::Vector3f& origin) {
-    RTCRay16& ray = rayhit.ray;
-    for (int i = 0; i < kPacket; ++i) {
+    auto& ray = rayhit.ray;
+    for (int i = 0; i < kSize; ++i) {
       ray.org_x[i] = origin.x();
       ray.org_y[i] = origin.y();
       ray.org_z[i] = origin.z();
@@ -255,18 +272,21 @@ SONOMAP_AVX512_KERNEL void incidence_row_avx512(int width, const RayDirections& 
   incidence_row(width, rays, v, z, nx, ny, nz, incidence);
 }
 
-}  // namespace
+// What a packet's rays are cast into: the scene and how to read a hit's normal in the world.
+struct TracedScene {
+  RTCScene scene;
+  unsigned statics_id;                                     // the statics' instance (world frame)
+  const std::vector<Eigen::Matrix3f>& instance_rotation;  // per instance, its rotation
+};
 
-void World::cast(const PinholeRays& rays, RayHits& hits) const {
-  const Impl& w = *impl_;
+// Casts the image's rays in packets of Tiles' shape, rows of tiles spread over TBB threads.
+template <class Tiles>
+void cast_tiles(const TracedScene& traced, const PinholeRays& rays, RayHits& hits) {
+  constexpr int kW = Tiles::kW, kH = Tiles::kH, kSize = kW * kH;
   const int width = rays.width, height = rays.height;
-  hits.width = width;
-  hits.height = height;
-  hits.z.resize(static_cast<std::size_t>(width) * height);  // every pixel is written below
-  hits.incidence.resize(hits.z.size());
-  const int tiles_x = (width + kTileW - 1) / kTileW;
-  const int tiles_y = (height + kTileH - 1) / kTileH;
-  const RayDirections directions(rays, tiles_x * kTileW, tiles_y * kTileH);
+  const int tiles_x = (width + kW - 1) / kW;
+  const int tiles_y = (height + kH - 1) / kH;
+  const RayDirections directions(rays, tiles_x * kW, tiles_y * kH);
   const Eigen::Vector3f origin = rays.world_T_camera.translation().cast<float>();
   const auto incidence_of_row =
       kernel_for(vector_isa(), &incidence_row_baseline, &incidence_row_avx2, &incidence_row_avx512);
@@ -275,16 +295,16 @@ void World::cast(const PinholeRays& rays, RayHits& hits) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    Packet packet(origin);
-    RTCRay16& ray = packet.rayhit.ray;
-    RTCHit16& hit = packet.rayhit.hit;
-    // World normals of a tile row's hits: x, y and z planes, each kTileH image rows.
-    const std::size_t row_stride = static_cast<std::size_t>(tiles_x) * kTileW, plane = kTileH * row_stride;
+    Packet<Tiles> packet(origin);
+    auto& ray = packet.rayhit.ray;
+    auto& hit = packet.rayhit.hit;
+    // World normals of a tile row's hits: x, y and z planes, each kH image rows.
+    const std::size_t row_stride = static_cast<std::size_t>(tiles_x) * kW, plane = kH * row_stride;
     std::vector<float> normals(3 * plane);
     for (int ty = range.begin(); ty < range.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
-        for (int i = 0; i < kPacket; ++i) {
-          const int u = tx * kTileW + i % kTileW, v = ty * kTileH + i / kTileW;
+        for (int i = 0; i < kSize; ++i) {
+          const int u = tx * kW + i % kW, v = ty * kH + i / kW;
           packet.valid[i] = (u < width && v < height) ? -1 : 0;
           ray.dir_x[i] = directions.column_x[u] + directions.row[v].x();
           ray.dir_y[i] = directions.column_y[u] + directions.row[v].y();
@@ -293,33 +313,49 @@ void World::cast(const PinholeRays& rays, RayHits& hits) const {
           hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
           hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(packet.valid, w.traced, &context, &packet.rayhit);
-        for (int i = 0; i < kPacket; ++i) {
+        Tiles::intersect(packet.valid, traced.scene, &context, &packet.rayhit);
+        for (int i = 0; i < kSize; ++i) {
           if (!packet.valid[i]) continue;
-          const int u = tx * kTileW + i % kTileW, row = i / kTileW, v = ty * kTileH + row;
+          const int u = tx * kW + i % kW, row = i / kW, v = ty * kH + row;
           const bool hit_something = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
           hits.z[static_cast<std::size_t>(v) * width + u] =
               hit_something ? ray.tfar[i] : std::numeric_limits<float>::infinity();
           // Embree gives a mover's normal in the mover's frame; the statics are in the world frame.
           const unsigned instance = hit.instID[0][i];
-          const bool mover = hit_something && instance != RTC_INVALID_GEOMETRY_ID && instance != w.statics_id;
-          const Eigen::Vector3f n = mover
-                                        ? rotated(w.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i])
-                                        : Eigen::Vector3f(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
+          const bool mover = hit_something && instance != RTC_INVALID_GEOMETRY_ID && instance != traced.statics_id;
+          const Eigen::Vector3f n =
+              mover ? rotated(traced.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i])
+                    : Eigen::Vector3f(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
           const std::size_t at = row * row_stride + u;
           normals[at] = n.x();
           normals[plane + at] = n.y();
           normals[2 * plane + at] = n.z();
         }
       }
-      for (int row = 0; row < kTileH && ty * kTileH + row < height; ++row) {
-        const int v = ty * kTileH + row;
+      for (int row = 0; row < kH && ty * kH + row < height; ++row) {
+        const int v = ty * kH + row;
         const std::size_t at = row * row_stride, p = static_cast<std::size_t>(v) * width;
         incidence_of_row(width, directions, v, hits.z.data() + p, normals.data() + at, normals.data() + plane + at,
                          normals.data() + 2 * plane + at, hits.incidence.data() + p);
       }
     }
   });
+}
+
+}  // namespace
+
+void World::cast(const PinholeRays& rays, RayHits& hits, Packet packet) const {
+  hits.width = rays.width;
+  hits.height = rays.height;
+  hits.z.resize(static_cast<std::size_t>(rays.width) * rays.height);  // every pixel is written
+  hits.incidence.resize(hits.z.size());
+  const TracedScene traced{impl_->traced, impl_->statics_id, impl_->instance_rotation};
+  if (packet == Packet::Native) packet = vector_isa() == VectorIsa::Avx512 ? Packet::Rays16 : Packet::Rays8;
+  if (packet == Packet::Rays16) {
+    cast_tiles<Tiles16>(traced, rays, hits);
+  } else {
+    cast_tiles<Tiles8>(traced, rays, hits);
+  }
 }
 
 }  // namespace sonomap::sim

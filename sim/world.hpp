@@ -74,11 +74,15 @@ class World {
   // Places every moving object at its pose at time t; objects absent at t are disabled.
   void set_time(double t);
 
-  // Traces one ray per pixel (packets of 16 = 4x4 pixels, rows of packets spread over TBB
-  // threads) into `hits`, reusing its buffers. Every ray is independent, so the result does not
-  // depend on the thread count; the incidence angles are computed by vectorised row loops
-  // (core/vector_isa.hpp), the same bits with any instruction set.
-  void cast(const PinholeRays& rays, RayHits& hits) const;
+  // Embree's ray packets: 16 rays (4x4 pixels) or 8 (4x2). Native: 16 where the vectorised
+  // loops run AVX-512 (vector_isa()), else 8, the widest packet Embree runs natively there.
+  enum class Packet { Native, Rays8, Rays16 };
+
+  // Traces one ray per pixel (packets of pixel tiles, rows of tiles spread over TBB threads)
+  // into `hits`, reusing its buffers. Every ray is independent, so the result depends neither
+  // on the thread count nor on the packet; the incidence angles are computed by vectorised
+  // row loops (core/vector_isa.hpp), the same bits with any instruction set.
+  void cast(const PinholeRays& rays, RayHits& hits, Packet packet = Packet::Native) const;
   RayHits cast(const PinholeRays& rays) const {
     RayHits hits;
     cast(rays, hits);
