@@ -85,6 +85,8 @@ struct World::Impl {
   // World rotation of each instance by its geometry id in `top` (to bring Embree's
   // object-space Ng into the world frame).
   std::vector<Eigen::Matrix3f> instance_rotation;
+  // Whether Embree traces 16-ray packets natively on this CPU (with AVX-512), else 8-ray ones.
+  bool native_ray16 = false;
 
   ~Impl() {
     for (Mover& m : movers)
@@ -115,6 +117,7 @@ World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.device = rtcNewDevice(nullptr);
   if (!w.device) throw std::runtime_error("embree: could not create a device");
+  w.native_ray16 = rtcGetDeviceProperty(w.device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
   w.top = rtcNewScene(w.device);
   rtcSetSceneFlags(w.top, RTC_SCENE_FLAG_ROBUST);
 
@@ -350,7 +353,7 @@ void World::cast(const PinholeRays& rays, RayHits& hits, Packet packet) const {
   hits.z.resize(static_cast<std::size_t>(rays.width) * rays.height);  // every pixel is written
   hits.incidence.resize(hits.z.size());
   const TracedScene traced{impl_->traced, impl_->statics_id, impl_->instance_rotation};
-  if (packet == Packet::Native) packet = vector_isa() == VectorIsa::Avx512 ? Packet::Rays16 : Packet::Rays8;
+  if (packet == Packet::Native) packet = impl_->native_ray16 ? Packet::Rays16 : Packet::Rays8;
   if (packet == Packet::Rays16) {
     cast_tiles<Tiles16>(traced, rays, hits);
   } else {

@@ -74,8 +74,8 @@ class World {
   // Places every moving object at its pose at time t; objects absent at t are disabled.
   void set_time(double t);
 
-  // Embree's ray packets: 16 rays (4x4 pixels) or 8 (4x2). Native: 16 where the vectorised
-  // loops run AVX-512 (vector_isa()), else 8, the widest packet Embree runs natively there.
+  // Embree's ray packets: 16 rays (4x4 pixels) or 8 (4x2). Native: 16 where Embree says it
+  // traces 16 rays natively (its AVX-512 kernels), else 8 (AVX2 and below).
   enum class Packet { Native, Rays8, Rays16 };
 
   // Traces one ray per pixel (packets of pixel tiles, rows of tiles spread over TBB threads)
