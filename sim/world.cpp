@@ -28,6 +28,11 @@ void throw_on_device_error(RTCDevice device, const char* what) {
                              std::to_string(static_cast<int>(error)) + ")");
 }
 
+// Whether Embree traces 16-ray packets natively on this CPU (its AVX-512 kernels).
+bool traces_ray16_natively(RTCDevice device) {
+  return rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+}
+
 // A scene holding one triangle geometry with `mesh` placed by `transform`.
 RTCScene make_mesh_scene(RTCDevice device, const TriangleMesh& mesh, const Eigen::Isometry3d& transform,
                          RTCBuildQuality quality) {
@@ -113,11 +118,19 @@ struct World::Impl {
   }
 };
 
+int native_packet_rays() {
+  RTCDevice device = rtcNewDevice(nullptr);
+  if (!device) throw std::runtime_error("embree: could not create a device");
+  const bool ray16 = traces_ray16_natively(device);
+  rtcReleaseDevice(device);
+  return ray16 ? 16 : 8;
+}
+
 World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.device = rtcNewDevice(nullptr);
   if (!w.device) throw std::runtime_error("embree: could not create a device");
-  w.native_ray16 = rtcGetDeviceProperty(w.device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+  w.native_ray16 = traces_ray16_natively(w.device);
   w.top = rtcNewScene(w.device);
   rtcSetSceneFlags(w.top, RTC_SCENE_FLAG_ROBUST);
 

@@ -61,6 +61,10 @@ inline float incidence_angle(float cos_angle) {
   return static_cast<float>(std::sqrt(1.0 - x) * p);
 }
 
+// The rays of the packets World::cast traces by default on this CPU (World::Packet::Native):
+// 16 where Embree traces 16-ray packets natively, else 8. For reports.
+int native_packet_rays();
+
 class World {
  public:
   // Builds the Embree scenes from the scenario's meshes (mesh_of: empty meshes of primitives

@@ -178,10 +178,11 @@ void bench_render(const BenchRenderOptions& options, const GlobalOptions& global
   progress.finish();
 
   const double rays = static_cast<double>(scenario.camera.width) * scenario.camera.height;
-  std::printf("bench render: '%s', %dx%d, %zu triangles, %d frames, noise %s, %s loops (medians)\n",
+  std::printf("bench render: '%s', %dx%d, %zu triangles, %d frames, noise %s, %s loops, Embree packets "
+              "of %d rays (medians)\n",
               scenario.name.c_str(), scenario.camera.width, scenario.camera.height, triangles, count,
               scenario.noise.model == sim::NoiseSpec::Model::None ? "none" : "kinect",
-              name_of(vector_isa()));
+              name_of(vector_isa()), sim::native_packet_rays());
   std::printf("rays: Embree casting only; noise: the noise model alone (sim::apply_noise on the exact\n"
               "image); render: Simulation::render (rays, noise, points, poses), Mrays/s = pixels / render.\n"
               "wall = elapsed time; cpu = CPU time of all threads (the 1-thread cpu figure is the\n"
