@@ -204,13 +204,13 @@ struct Tiles8 {
 
 // One packet of kW x kH rays: pixel i of the packet is (u0 + i % kW, v0 + i / kW).
 template <class Tiles>
-struct Packet {
+struct RayPacket {
   static constexpr int kSize = Tiles::kW * Tiles::kH;
   alignas(64) typename Tiles::RayHit rayhit;
   alignas(64) int valid[kSize];  // Embree needs both aligned to the packet's bytes
 
   // The fields no intersection changes, set once: origin, interval start, time, mask, flags.
-  explicit Packet(const Eigen::Vector3f& origin) {
+  explicit RayPacket(const Eigen::Vector3f& origin) {
     auto& ray = rayhit.ray;
     for (int i = 0; i < kSize; ++i) {
       ray.org_x[i] = origin.x();
@@ -311,7 +311,7 @@ void cast_tiles(const TracedScene& traced, const PinholeRays& rays, RayHits& hit
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    Packet<Tiles> packet(origin);
+    RayPacket<Tiles> packet(origin);
     auto& ray = packet.rayhit.ray;
     auto& hit = packet.rayhit.hit;
     // World normals of a tile row's hits: x, y and z planes, each kH image rows.
