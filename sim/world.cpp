@@ -28,9 +28,11 @@ void throw_on_device_error(RTCDevice device, const char* what) {
                              std::to_string(static_cast<int>(error)) + ")");
 }
 
-// Whether Embree traces 16-ray packets natively on this CPU (its AVX-512 kernels).
-bool traces_ray16_natively(RTCDevice device) {
-  return rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+// The packet World::cast traces by default: 16 rays where Embree traces them natively on this
+// CPU (its AVX-512 kernels), else 8.
+World::Packet native_packet(RTCDevice device) {
+  return rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0 ? World::Packet::Rays16
+                                                                                       : World::Packet::Rays8;
 }
 
 // A scene holding one triangle geometry with `mesh` placed by `transform`.
@@ -90,8 +92,7 @@ struct World::Impl {
   // World rotation of each instance by its geometry id in `top` (to bring Embree's
   // object-space Ng into the world frame).
   std::vector<Eigen::Matrix3f> instance_rotation;
-  // Whether Embree traces 16-ray packets natively on this CPU (with AVX-512), else 8-ray ones.
-  bool native_ray16 = false;
+  World::Packet native = World::Packet::Rays8;  // what Packet::Native stands for (native_packet)
 
   ~Impl() {
     for (Mover& m : movers)
@@ -121,16 +122,16 @@ struct World::Impl {
 int native_packet_rays() {
   RTCDevice device = rtcNewDevice(nullptr);
   if (!device) throw std::runtime_error("embree: could not create a device");
-  const bool ray16 = traces_ray16_natively(device);
+  const World::Packet packet = native_packet(device);
   rtcReleaseDevice(device);
-  return ray16 ? 16 : 8;
+  return packet == World::Packet::Rays16 ? 16 : 8;
 }
 
 World::World(const Scenario& scenario) : impl_(std::make_unique<Impl>()) {
   Impl& w = *impl_;
   w.device = rtcNewDevice(nullptr);
   if (!w.device) throw std::runtime_error("embree: could not create a device");
-  w.native_ray16 = traces_ray16_natively(w.device);
+  w.native = native_packet(w.device);
   w.top = rtcNewScene(w.device);
   rtcSetSceneFlags(w.top, RTC_SCENE_FLAG_ROBUST);
 
@@ -366,7 +367,7 @@ void World::cast(const PinholeRays& rays, RayHits& hits, Packet packet) const {
   hits.z.resize(static_cast<std::size_t>(rays.width) * rays.height);  // every pixel is written
   hits.incidence.resize(hits.z.size());
   const TracedScene traced{impl_->traced, impl_->statics_id, impl_->instance_rotation};
-  if (packet == Packet::Native) packet = impl_->native_ray16 ? Packet::Rays16 : Packet::Rays8;
+  if (packet == Packet::Native) packet = impl_->native;
   if (packet == Packet::Rays16) {
     cast_tiles<Tiles16>(traced, rays, hits);
   } else {

@@ -137,6 +137,7 @@ TEST_CASE("Open3D fuses an organised cloud as the depth image it came from", "[s
     CHECK(std::stod(estimate) == Approx(test::square_room_truth(k)).margin(0.05));
   }
 }
+
 TEST_CASE("reading a 3000-message bag keeps memory flat", "[sequence][rosbag]") {
 #if defined(__SANITIZE_ADDRESS__)
   SONOMAP_SKIP("AddressSanitizer keeps freed memory in quarantine: peak RSS says nothing here");
