@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -296,10 +297,130 @@ struct TracedScene {
   const std::vector<Eigen::Matrix3f>& instance_rotation;  // per instance, its rotation
 };
 
+// A tile row's world normals: x, y and z planes of kH image rows each, `row_stride` apart.
+struct TileRowNormals {
+  TileRowNormals(int row_stride, int rows)
+      : row_stride(static_cast<std::size_t>(row_stride)), plane(rows * this->row_stride), xyz(3 * plane) {}
+  float* x() { return xyz.data(); }
+  float* y() { return xyz.data() + plane; }
+  float* z() { return xyz.data() + 2 * plane; }
+  std::size_t row_stride, plane;
+  std::vector<float> xyz;
+};
+
+// A tile row: kW = 4 pixels, one SSE vector (GCC's vector extensions), so that aiming and
+// reading a packet are a few vector instructions per row instead of a loop per pixel.
+typedef float Float4 __attribute__((vector_size(16)));
+typedef std::int32_t Int4 __attribute__((vector_size(16)));
+template <class T>
+T load4(const void* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+template <class T>
+void store4(void* p, const T& v) {
+  std::memcpy(p, &v, sizeof v);
+}
+
+// Points packet (tx, ty)'s rays from the camera through its pixels; pixels beyond the image
+// are off.
+template <class Tiles>
+void aim(RayPacket<Tiles>& packet, const RayDirections& directions, int tx, int ty, int width, int height) {
+  static_assert(Tiles::kW == 4, "a tile row is one Float4");
+  auto& ray = packet.rayhit.ray;
+  const int u = tx * Tiles::kW;
+  const auto column_x = load4<Float4>(&directions.column_x[u]);
+  const auto column_y = load4<Float4>(&directions.column_y[u]);
+  const auto column_z = load4<Float4>(&directions.column_z[u]);
+  for (int row = 0; row < Tiles::kH; ++row) {
+    const int v = ty * Tiles::kH + row, i = row * Tiles::kW;
+    const Eigen::Vector3f& d = directions.row[v];
+    store4(&ray.dir_x[i], column_x + d.x());
+    store4(&ray.dir_y[i], column_y + d.y());
+    store4(&ray.dir_z[i], column_z + d.z());
+    store4(&packet.valid[i], (u + Int4{0, 1, 2, 3} < width) & (v < height ? -1 : 0));  // -1: on, as Embree wants
+  }
+  const Float4 far = Float4{} + std::numeric_limits<float>::infinity();
+  const Int4 none = Int4{} + static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
+  for (int i = 0; i < RayPacket<Tiles>::kSize; i += 4) {
+    store4(&ray.tfar[i], far);
+    store4(&packet.rayhit.hit.geomID[i], none);
+    store4(&packet.rayhit.hit.instID[0][i], none);
+  }
+}
+
+// Whether any ray of the packet hit a mover (an instance other than the statics'), four at a
+// time: most packets hit the statics or nothing.
+template <class Hit>
+bool any_mover(const Hit& hit, unsigned statics_id) {
+  constexpr int kSize = sizeof(hit.geomID) / sizeof(hit.geomID[0]);
+  const auto invalid = static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
+  Int4 mover = {};
+  for (int i = 0; i < kSize; i += 4) {
+    const auto instance = load4<Int4>(&hit.instID[0][i]);
+    mover |= (load4<Int4>(&hit.geomID[i]) != invalid) & (instance != invalid) &
+             (instance != static_cast<std::int32_t>(statics_id));
+  }
+  return (mover[0] | mover[1] | mover[2] | mover[3]) != 0;
+}
+
+// Packet (tx, ty)'s hits as they come: the depth along each ray (+infinity: nothing hit) into
+// the image, the normals into the tile row's planes. A tile on the image's border goes pixel
+// by pixel.
+template <class Tiles>
+void read_hits(const RayPacket<Tiles>& packet, int tx, int ty, RayHits& hits, TileRowNormals& normals) {
+  const auto& ray = packet.rayhit.ray;
+  const auto& hit = packet.rayhit.hit;
+  const bool whole = (tx + 1) * Tiles::kW <= hits.width && (ty + 1) * Tiles::kH <= hits.height;
+  const Float4 nothing = Float4{} + std::numeric_limits<float>::infinity();
+  const auto missed = static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
+  for (int row = 0; row < Tiles::kH; ++row) {
+    const int v = ty * Tiles::kH + row, i = row * Tiles::kW;
+    if (v >= hits.height) break;  // a tile on the image's last rows
+    float* z = hits.z.data() + static_cast<std::size_t>(v) * hits.width + tx * Tiles::kW;
+    const std::size_t at = row * normals.row_stride + tx * Tiles::kW;
+    if (whole) {
+      store4(z, load4<Int4>(&hit.geomID[i]) == missed ? nothing : load4<Float4>(&ray.tfar[i]));
+      std::memcpy(normals.x() + at, &hit.Ng_x[i], sizeof(Float4));
+      std::memcpy(normals.y() + at, &hit.Ng_y[i], sizeof(Float4));
+      std::memcpy(normals.z() + at, &hit.Ng_z[i], sizeof(Float4));
+      continue;
+    }
+    for (int column = 0; column < Tiles::kW; ++column) {
+      const int k = i + column;
+      if (!packet.valid[k]) continue;
+      z[column] = hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? ray.tfar[k] : std::numeric_limits<float>::infinity();
+      normals.x()[at + column] = hit.Ng_x[k];
+      normals.y()[at + column] = hit.Ng_y[k];
+      normals.z()[at + column] = hit.Ng_z[k];
+    }
+  }
+}
+
+// Embree gives a mover's normal in the mover's frame (the statics' are in the world frame):
+// packet (tx, ·)'s movers' normals turned into the world.
+template <class Tiles>
+void turn_mover_normals(const RayPacket<Tiles>& packet, const TracedScene& traced, int tx, TileRowNormals& normals) {
+  const auto& hit = packet.rayhit.hit;
+  if (!any_mover(hit, traced.statics_id)) return;
+  for (int i = 0; i < RayPacket<Tiles>::kSize; ++i) {
+    const unsigned instance = hit.instID[0][i];
+    const bool mover = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID && instance != RTC_INVALID_GEOMETRY_ID &&
+                       instance != traced.statics_id;
+    if (!packet.valid[i] || !mover) continue;
+    const Eigen::Vector3f n = rotated(traced.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
+    const std::size_t at = (i / Tiles::kW) * normals.row_stride + tx * Tiles::kW + i % Tiles::kW;
+    normals.x()[at] = n.x();
+    normals.y()[at] = n.y();
+    normals.z()[at] = n.z();
+  }
+}
+
 // Casts the image's rays in packets of Tiles' shape, rows of tiles spread over TBB threads.
 template <class Tiles>
 void cast_tiles(const TracedScene& traced, const PinholeRays& rays, RayHits& hits) {
-  constexpr int kW = Tiles::kW, kH = Tiles::kH, kSize = kW * kH;
+  constexpr int kW = Tiles::kW, kH = Tiles::kH;
   const int width = rays.width, height = rays.height;
   const int tiles_x = (width + kW - 1) / kW;
   const int tiles_y = (height + kH - 1) / kH;
@@ -313,47 +434,19 @@ void cast_tiles(const TracedScene& traced, const PinholeRays& rays, RayHits& hit
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     RayPacket<Tiles> packet(origin);
-    auto& ray = packet.rayhit.ray;
-    auto& hit = packet.rayhit.hit;
-    // World normals of a tile row's hits: x, y and z planes, each kH image rows.
-    const std::size_t row_stride = static_cast<std::size_t>(tiles_x) * kW, plane = kH * row_stride;
-    std::vector<float> normals(3 * plane);
+    TileRowNormals normals(tiles_x * kW, kH);
     for (int ty = range.begin(); ty < range.end(); ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
-        for (int i = 0; i < kSize; ++i) {
-          const int u = tx * kW + i % kW, v = ty * kH + i / kW;
-          packet.valid[i] = (u < width && v < height) ? -1 : 0;
-          ray.dir_x[i] = directions.column_x[u] + directions.row[v].x();
-          ray.dir_y[i] = directions.column_y[u] + directions.row[v].y();
-          ray.dir_z[i] = directions.column_z[u] + directions.row[v].z();
-          ray.tfar[i] = std::numeric_limits<float>::infinity();
-          hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-          hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-        }
+        aim(packet, directions, tx, ty, width, height);
         Tiles::intersect(packet.valid, traced.scene, &context, &packet.rayhit);
-        for (int i = 0; i < kSize; ++i) {
-          if (!packet.valid[i]) continue;
-          const int u = tx * kW + i % kW, row = i / kW, v = ty * kH + row;
-          const bool hit_something = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-          hits.z[static_cast<std::size_t>(v) * width + u] =
-              hit_something ? ray.tfar[i] : std::numeric_limits<float>::infinity();
-          // Embree gives a mover's normal in the mover's frame; the statics are in the world frame.
-          const unsigned instance = hit.instID[0][i];
-          const bool mover = hit_something && instance != RTC_INVALID_GEOMETRY_ID && instance != traced.statics_id;
-          const Eigen::Vector3f n =
-              mover ? rotated(traced.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i])
-                    : Eigen::Vector3f(hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
-          const std::size_t at = row * row_stride + u;
-          normals[at] = n.x();
-          normals[plane + at] = n.y();
-          normals[2 * plane + at] = n.z();
-        }
+        read_hits(packet, tx, ty, hits, normals);
+        turn_mover_normals(packet, traced, tx, normals);
       }
       for (int row = 0; row < kH && ty * kH + row < height; ++row) {
         const int v = ty * kH + row;
-        const std::size_t at = row * row_stride, p = static_cast<std::size_t>(v) * width;
-        incidence_of_row(width, directions, v, hits.z.data() + p, normals.data() + at, normals.data() + plane + at,
-                         normals.data() + 2 * plane + at, hits.incidence.data() + p);
+        const std::size_t at = row * normals.row_stride, p = static_cast<std::size_t>(v) * width;
+        incidence_of_row(width, directions, v, hits.z.data() + p, normals.x() + at, normals.y() + at, normals.z() + at,
+                         hits.incidence.data() + p);
       }
     }
   });

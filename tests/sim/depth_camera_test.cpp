@@ -45,6 +45,25 @@ TEST_CASE("a wall 2 m ahead reads 2 m at the centre pixel and everywhere (z-dept
   CHECK(f.points_camera.size() == 640u * 480u);
 }
 
+// Rays are cast in tiles of 4 x 2 or 4 x 4 pixels; at 643 x 482 the last tiles of each row and
+// column hang over the image's edge, and the wall must still fill the image to its last pixel.
+TEST_CASE("a wall 2 m ahead fills an image whose size is no multiple of the ray tiles", "[sim][camera]") {
+  Scenario s = test::wall_scenario(2.0);
+  s.camera.width = 643;
+  s.camera.height = 482;
+  s.camera.cx = 321.0;
+  s.camera.cy = 240.5;
+  Simulation sim(s);
+  const Frame f = sim.render(0);
+  REQUIRE(f.depth.size() == 643u * 482u);
+  CHECK(depth_at(f, 642, 481) == Approx(2.0).epsilon(1e-5));
+  CHECK(depth_at(f, 642, 0) == Approx(2.0).epsilon(1e-5));
+  CHECK(depth_at(f, 0, 481) == Approx(2.0).epsilon(1e-5));
+  const auto off_wall = std::count_if(f.depth.begin(), f.depth.end(), [](float z) { return std::abs(z - 2.0f) > 2e-5f; });
+  CHECK(off_wall == 0);
+  CHECK(f.points_camera.size() == 643u * 482u);
+}
+
 TEST_CASE("walls beyond max range or nearer than min range read no return", "[sim][camera]") {
   Scenario far = test::wall_scenario(5.5);
   far.camera.max_range = 5.0;
