@@ -16,8 +16,7 @@ void DepthCamera::trace(const World& world, const Eigen::Isometry3d& world_T_cam
   hits.z.swap(image.z);
   hits.incidence.swap(image.incidence);
   world.cast(PinholeRays::of(spec_, world_T_camera), hits);
-  for (float& z : hits.z)
-    if (!std::isfinite(z)) z = 0.0f;  // nothing hit: no return (incidence is 0 there)
+  for (float& z : hits.z) z = std::isfinite(z) ? z : 0.0f;  // nothing hit: no return (incidence is 0 there)
   image.width = spec_.width;
   image.height = spec_.height;
   image.z.swap(hits.z);
@@ -25,8 +24,8 @@ void DepthCamera::trace(const World& world, const Eigen::Isometry3d& world_T_cam
 }
 
 DepthImage DepthCamera::clip_to_range(DepthImage image) const {
-  for (float& z : image.z)
-    if (z < spec_.min_range || z > spec_.max_range) z = 0.0f;
+  const double near = spec_.min_range, far = spec_.max_range;
+  for (float& z : image.z) z = (z < near) | (z > far) ? 0.0f : z;  // a selection, which vectorises
   return image;
 }
 
