@@ -175,12 +175,15 @@ std::vector<StampedPose> read_groundtruth(const fs::path& file) {
   std::vector<StampedPose> poses;
   double previous = -INFINITY;
   for_each_row(file, [&](int line, const std::vector<std::string>& words) {
-    double v[8];
-    bool ok = words.size() == 8;
-    for (std::size_t i = 0; ok && i < 8; ++i) ok = parse_number(words[i], v[i]);
-    if (!ok)
+    static const char* const kFields[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+    if (words.size() != 8)
       throw InputError(file.string(), line, "",
-                       "expected 8 numbers: timestamp tx ty tz qx qy qz qw");
+                       "expected 8 numbers: timestamp tx ty tz qx qy qz qw; found " + std::to_string(words.size()) +
+                           " fields");
+    double v[8];
+    for (std::size_t i = 0; i < 8; ++i)
+      if (!parse_number(words[i], v[i]))
+        throw InputError(file.string(), line, kFields[i], "'" + words[i] + "' is not a finite number");
     check_time_order(file, line, v[0], previous);
     if (std::max({std::abs(v[1]), std::abs(v[2]), std::abs(v[3])}) > kMaxPosition)
       throw InputError(file.string(), line, "",
@@ -284,8 +287,11 @@ TumSequence read_tum_sequence(const fs::path& dir, double max_time_difference) {
   double previous = -INFINITY;
   for_each_row(depth_list, [&](int line, const std::vector<std::string>& words) {
     TumFrameInfo info;
-    if (words.size() != 2 || !parse_number(words[0], info.timestamp))
-      throw InputError(depth_list.string(), line, "", "expected: timestamp filename");
+    if (words.size() != 2)
+      throw InputError(depth_list.string(), line, "",
+                       "expected: timestamp filename; found " + std::to_string(words.size()) + " fields");
+    if (!parse_number(words[0], info.timestamp))
+      throw InputError(depth_list.string(), line, "timestamp", "'" + words[0] + "' is not a finite number");
     check_time_order(depth_list, line, info.timestamp, previous);
     info.depth_file = dir / words[1];
     const StampedPose* pose = nearest(poses, info.timestamp, max_time_difference);

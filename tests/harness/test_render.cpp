@@ -195,6 +195,22 @@ TEST_CASE("reading a sequence: malformed lines name the file and line", "[render
     dir.write("seq/groundtruth.txt", "# gt\n0.0 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 1\n");
     const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
     CHECK(message.find("groundtruth.txt:3:") != std::string::npos);
+    CHECK(message.find("found 7 fields") != std::string::npos);
+  }
+  SECTION("a ground-truth line with a quaternion component that is not a number") {
+    dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n0.5 0 0 0 nan 0 0 1\n");
+    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
+    CHECK(message.find("groundtruth.txt:2:") != std::string::npos);
+    CHECK(message.find("'qx'") != std::string::npos);
+    CHECK(message.find("'nan' is not a finite number") != std::string::npos);
+  }
+  SECTION("a depth list whose timestamp is not a number") {
+    dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n");
+    dir.write("seq/depth.txt", "# depth maps\n0.0 depth/0.png\n0,5 depth/1.png\n");
+    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
+    CHECK(message.find("depth.txt:3:") != std::string::npos);
+    CHECK(message.find("'timestamp'") != std::string::npos);
+    CHECK(message.find("'0,5' is not a finite number") != std::string::npos);
   }
   SECTION("frames without a pose close in time are left out") {
     dir.write("seq/groundtruth.txt", "0.001 1 2 3 0 0 0 1\n");
