@@ -191,26 +191,34 @@ TEST_CASE("reading a sequence: malformed lines name the file and line", "[render
   ScratchDir dir("render");
   dir.write("seq/camera.yaml", "width: 4\nheight: 2\nintrinsics: {fx: 3, fy: 3, cx: 1.5, cy: 0.5}\n");
   dir.write("seq/depth.txt", "# depth maps\n0.0 depth/0.png\n0.5 depth/1.png\n");
+  const auto reading_error = [&] {
+    return input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
+  };
   SECTION("a ground-truth line with 7 numbers") {
     dir.write("seq/groundtruth.txt", "# gt\n0.0 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 1\n");
-    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
+    const std::string message = reading_error();
     CHECK(message.find("groundtruth.txt:3:") != std::string::npos);
     CHECK(message.find("found 7 fields") != std::string::npos);
   }
-  SECTION("a ground-truth line with a quaternion component that is not a number") {
-    dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n0.5 0 0 0 nan 0 0 1\n");
-    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
-    CHECK(message.find("groundtruth.txt:2:") != std::string::npos);
-    CHECK(message.find("'qx'") != std::string::npos);
-    CHECK(message.find("'nan' is not a finite number") != std::string::npos);
-  }
-  SECTION("a depth list whose timestamp is not a number") {
-    dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n");
-    dir.write("seq/depth.txt", "# depth maps\n0.0 depth/0.png\n0,5 depth/1.png\n");
-    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
-    CHECK(message.find("depth.txt:3:") != std::string::npos);
-    CHECK(message.find("'timestamp'") != std::string::npos);
-    CHECK(message.find("'0,5' is not a finite number") != std::string::npos);
+  SECTION("a field that is not a number is named, with its text") {
+    struct Case {
+      const char* file;
+      const char* text;
+      const char* where;
+      const char* field;
+    };
+    for (const Case& bad : {Case{"seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n0.5 0 0 0 nan 0 0 1\n",
+                                 "groundtruth.txt:2:", "'qx': 'nan' is not a finite number"},
+                            Case{"seq/depth.txt", "# depth maps\n0.0 depth/0.png\n0,5 depth/1.png\n", "depth.txt:3:",
+                                 "'timestamp': '0,5' is not a finite number"}}) {
+      INFO(bad.file);
+      dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n");
+      dir.write("seq/depth.txt", "# depth maps\n0.0 depth/0.png\n");
+      dir.write(bad.file, bad.text);
+      const std::string message = reading_error();
+      CHECK(message.find(bad.where) != std::string::npos);
+      CHECK(message.find(bad.field) != std::string::npos);
+    }
   }
   SECTION("frames without a pose close in time are left out") {
     dir.write("seq/groundtruth.txt", "0.001 1 2 3 0 0 0 1\n");
@@ -222,7 +230,7 @@ TEST_CASE("reading a sequence: malformed lines name the file and line", "[render
   SECTION("an unknown key in camera.yaml") {
     dir.write("seq/groundtruth.txt", "0.0 0 0 0 0 0 0 1\n");
     dir.write("seq/camera.yaml", "width: 4\nheight: 2\nfocal: 3\n");
-    const std::string message = input_error_of([&] { sonomap::harness::read_tum_sequence(dir.path() / "seq"); });
+    const std::string message = reading_error();
     CHECK(message.find("camera.yaml:3:") != std::string::npos);
     CHECK(message.find("'focal'") != std::string::npos);
   }
