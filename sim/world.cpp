@@ -322,6 +322,9 @@ template <class T>
 void store4(void* p, const T& v) {
   std::memcpy(p, &v, sizeof v);
 }
+// A tile row of "nothing hit": tfar before a hit, the depth of a miss, and Embree's no-id.
+const Float4 kNoHitDepth = Float4{} + std::numeric_limits<float>::infinity();
+const Int4 kNoId = Int4{} + static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
 
 // Points packet (tx, ty)'s rays from the camera through its pixels; pixels beyond the image
 // are off.
@@ -341,28 +344,19 @@ void aim(RayPacket<Tiles>& packet, const RayDirections& directions, int tx, int 
     store4(&ray.dir_z[i], column_z + d.z());
     store4(&packet.valid[i], (u + Int4{0, 1, 2, 3} < width) & (v < height ? -1 : 0));  // -1: on, as Embree wants
   }
-  const Float4 far = Float4{} + std::numeric_limits<float>::infinity();
-  const Int4 none = Int4{} + static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
   for (int i = 0; i < RayPacket<Tiles>::kSize; i += 4) {
-    store4(&ray.tfar[i], far);
-    store4(&packet.rayhit.hit.geomID[i], none);
-    store4(&packet.rayhit.hit.instID[0][i], none);
+    store4(&ray.tfar[i], kNoHitDepth);
+    store4(&packet.rayhit.hit.geomID[i], kNoId);
+    store4(&packet.rayhit.hit.instID[0][i], kNoId);
   }
 }
 
-// Whether any ray of the packet hit a mover (an instance other than the statics'), four at a
-// time: most packets hit the statics or nothing.
+// Lanes i .. i + 3 of the packet that hit a mover (an instance other than the statics'): -1.
 template <class Hit>
-bool any_mover(const Hit& hit, unsigned statics_id) {
-  constexpr int kSize = sizeof(hit.geomID) / sizeof(hit.geomID[0]);
-  const auto invalid = static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
-  Int4 mover = {};
-  for (int i = 0; i < kSize; i += 4) {
-    const auto instance = load4<Int4>(&hit.instID[0][i]);
-    mover |= (load4<Int4>(&hit.geomID[i]) != invalid) & (instance != invalid) &
-             (instance != static_cast<std::int32_t>(statics_id));
-  }
-  return (mover[0] | mover[1] | mover[2] | mover[3]) != 0;
+Int4 mover_lanes(const Hit& hit, int i, unsigned statics_id) {
+  const auto instance = load4<Int4>(&hit.instID[0][i]);
+  return (load4<Int4>(&hit.geomID[i]) != kNoId) & (instance != kNoId) &
+         (instance != static_cast<std::int32_t>(statics_id));
 }
 
 // Packet (tx, ty)'s hits as they come: the depth along each ray (+infinity: nothing hit) into
@@ -373,15 +367,13 @@ void read_hits(const RayPacket<Tiles>& packet, int tx, int ty, RayHits& hits, Ti
   const auto& ray = packet.rayhit.ray;
   const auto& hit = packet.rayhit.hit;
   const bool whole = (tx + 1) * Tiles::kW <= hits.width && (ty + 1) * Tiles::kH <= hits.height;
-  const Float4 nothing = Float4{} + std::numeric_limits<float>::infinity();
-  const auto missed = static_cast<std::int32_t>(RTC_INVALID_GEOMETRY_ID);
   for (int row = 0; row < Tiles::kH; ++row) {
     const int v = ty * Tiles::kH + row, i = row * Tiles::kW;
     if (v >= hits.height) break;  // a tile on the image's last rows
     float* z = hits.z.data() + static_cast<std::size_t>(v) * hits.width + tx * Tiles::kW;
     const std::size_t at = row * normals.row_stride + tx * Tiles::kW;
     if (whole) {
-      store4(z, load4<Int4>(&hit.geomID[i]) == missed ? nothing : load4<Float4>(&ray.tfar[i]));
+      store4(z, load4<Int4>(&hit.geomID[i]) == kNoId ? kNoHitDepth : load4<Float4>(&ray.tfar[i]));
       std::memcpy(normals.x() + at, &hit.Ng_x[i], sizeof(Float4));
       std::memcpy(normals.y() + at, &hit.Ng_y[i], sizeof(Float4));
       std::memcpy(normals.z() + at, &hit.Ng_z[i], sizeof(Float4));
@@ -399,21 +391,23 @@ void read_hits(const RayPacket<Tiles>& packet, int tx, int ty, RayHits& hits, Ti
 }
 
 // Embree gives a mover's normal in the mover's frame (the statics' are in the world frame):
-// packet (tx, ·)'s movers' normals turned into the world.
+// packet (tx, ·)'s movers' normals turned into the world. Most tile rows hit no mover.
 template <class Tiles>
 void turn_mover_normals(const RayPacket<Tiles>& packet, const TracedScene& traced, int tx, TileRowNormals& normals) {
   const auto& hit = packet.rayhit.hit;
-  if (!any_mover(hit, traced.statics_id)) return;
-  for (int i = 0; i < RayPacket<Tiles>::kSize; ++i) {
-    const unsigned instance = hit.instID[0][i];
-    const bool mover = hit.geomID[i] != RTC_INVALID_GEOMETRY_ID && instance != RTC_INVALID_GEOMETRY_ID &&
-                       instance != traced.statics_id;
-    if (!packet.valid[i] || !mover) continue;
-    const Eigen::Vector3f n = rotated(traced.instance_rotation[instance], hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]);
-    const std::size_t at = (i / Tiles::kW) * normals.row_stride + tx * Tiles::kW + i % Tiles::kW;
-    normals.x()[at] = n.x();
-    normals.y()[at] = n.y();
-    normals.z()[at] = n.z();
+  for (int row = 0; row < Tiles::kH; ++row) {
+    const int i = row * Tiles::kW;
+    const Int4 movers = mover_lanes(hit, i, traced.statics_id) & load4<Int4>(&packet.valid[i]);
+    if (!(movers[0] | movers[1] | movers[2] | movers[3])) continue;
+    for (int column = 0; column < Tiles::kW; ++column) {
+      const int k = i + column;
+      if (!movers[column]) continue;
+      const Eigen::Vector3f n = rotated(traced.instance_rotation[hit.instID[0][k]], hit.Ng_x[k], hit.Ng_y[k], hit.Ng_z[k]);
+      const std::size_t at = row * normals.row_stride + tx * Tiles::kW + column;
+      normals.x()[at] = n.x();
+      normals.y()[at] = n.y();
+      normals.z()[at] = n.z();
+    }
   }
 }
 
