@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <ctime>
+#include <functional>
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace sonomap::harness {
@@ -18,6 +21,13 @@ void add_bench_sonify(CLI::App& bench, const GlobalOptions& global);
 // `sonomap bench map [SCENARIO]`: median ms per frame of each mapping stage and the rasters, per
 // voxel size, thread count and mapper, as ratios to Open3D's ScalableTSDFVolume on the same frames.
 void add_bench_map(CLI::App& bench, const GlobalOptions& global);
+
+// `--vector-loops best|baseline|avx2|avx512` on a benchmark: which copy of the vectorised loops
+// it runs (core/vector_isa.hpp; every copy computes the same bits). A machine with AVX-512 can
+// then time the loops an AVX2 or a baseline x86-64 machine runs. Returns where the choice is kept.
+std::shared_ptr<std::string> add_vector_loops_option(CLI::App& cmd);
+// Runs `bench` on the loops chosen; one this CPU lacks is an InputError (exit 2).
+void with_vector_loops(const std::string& choice, const std::function<void()>& bench);
 
 // The median of a non-empty sample (mean of the two middle values for an even count).
 inline double median(std::vector<double> values) {

@@ -198,6 +198,24 @@ void bench_render(const BenchRenderOptions& options, const GlobalOptions& global
 
 }  // namespace
 
+std::shared_ptr<std::string> add_vector_loops_option(CLI::App& cmd) {
+  auto choice = std::make_shared<std::string>("best");
+  cmd.add_option("--vector-loops", *choice,
+                 "The vectorised loops to run: best (the widest this CPU has), baseline, avx2 or avx512 "
+                 "(the same results; the speed of a lesser CPU)")
+      ->check(CLI::IsMember({"best", "baseline", "avx2", "avx512"}))
+      ->capture_default_str();
+  return choice;
+}
+
+void with_vector_loops(const std::string& choice, const std::function<void()>& bench) {
+  if (choice == "best") return bench();
+  const VectorIsa isa = choice == "avx512" ? VectorIsa::Avx512 : choice == "avx2" ? VectorIsa::Avx2 : VectorIsa::Baseline;
+  if (!supported(isa)) throw InputError("--vector-loops " + choice + ": this CPU lacks " + name_of(isa));
+  const ScopedVectorIsa loops(isa);
+  bench();
+}
+
 void add_bench_render(CLI::App& bench, const GlobalOptions& global) {
   auto options = std::make_shared<BenchRenderOptions>();
   CLI::App* cmd = bench.add_subcommand(
@@ -205,7 +223,8 @@ void add_bench_render(CLI::App& bench, const GlobalOptions& global) {
   cmd->add_option("scenario", options->scenario, "Scenario YAML (default: a built-in room)");
   cmd->add_option("--frames", options->frames, "Frames to time, spread over the scenario (default 60)")
       ->check(CLI::PositiveNumber);
-  cmd->callback([options, &global] { bench_render(*options, global); });
+  const auto loops = add_vector_loops_option(*cmd);
+  cmd->callback([options, loops, &global] { with_vector_loops(*loops, [&] { bench_render(*options, global); }); });
 }
 
 void add_bench_command(CLI::App& app, const GlobalOptions& global) {

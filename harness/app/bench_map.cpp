@@ -526,7 +526,8 @@ void add_bench_map(CLI::App& bench, const GlobalOptions& global) {
                   "surface as a spinning lidar's rings (18 rows of a 525 px focal length: 2 degrees)")
       ->capture_default_str();
   cmd->add_option("--json", options->json, "Write the results as JSON (atomically)");
-  cmd->callback([options, &global] { bench_map(*options, global); });
+  const auto loops = add_vector_loops_option(*cmd);
+  cmd->callback([options, loops, &global] { with_vector_loops(*loops, [&] { bench_map(*options, global); }); });
 }
 
 }  // namespace sonomap::harness

@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `sonomap bench map` end to end on the smoke scene: every mapper has every stage timed, the
 // Open3D reference surface lies where our TSDF's does (an independent implementation, same
-// frames), and bad input exits 2 writing nothing. No timing is asserted.
+// frames), bad input exits 2 writing nothing, and
+// the vectorised loops asked for are the ones timed. No timing is asserted.
 #include "cli_support.hpp"
 #include "test_scenario_files.hpp"
+
+#include "core/vector_isa.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -178,4 +181,41 @@ TEST_CASE("bench map times the mappers on clouds and a lidar's rings, and refuse
   CHECK(step.status == 2);
   CHECK_THAT(step.output, Catch::Contains("--row-step"));
   CHECK(sonomap::test::nothing_written(refused));
+}
+
+TEST_CASE("bench render and bench map run the vectorised loops asked for, and refuse loops this CPU lacks",
+          "[cli][bench]") {
+  const sonomap::test::ScratchDir scratch("bench-loops");
+  const fs::path file = scratch.path() / "bench.json";
+
+  // The baseline loops run on every CPU, and each benchmark says which loops it timed.
+  const auto render = run_sonomap({"-q", "bench", "render", "--frames", "1", "--vector-loops", "baseline"});
+  INFO(render.output);
+  CHECK(render.status == 0);
+  CHECK_THAT(render.output, Catch::Contains("baseline loops"));
+  auto arguments = bench_map_arguments(file);
+  arguments.insert(arguments.end(), {"--mappers", "vdb_gpdf", "--vector-loops", "baseline"});
+  const auto map = run_sonomap(arguments);
+  INFO(map.output);
+  REQUIRE(map.status == 0);
+  CHECK(json::parse(sonomap::test::text_of(file)).at("vector_loops") == "baseline");
+
+  // AVX-512 where the CPU has it; elsewhere exit 2, naming what is missing, and no file.
+  const fs::path wide = scratch.path() / "avx512.json";
+  arguments = bench_map_arguments(wide);
+  arguments.insert(arguments.end(), {"--mappers", "vdb_gpdf", "--vector-loops", "avx512"});
+  const auto avx512 = run_sonomap(arguments);
+  if (sonomap::supported(sonomap::VectorIsa::Avx512)) {
+    CHECK(avx512.status == 0);
+    CHECK(json::parse(sonomap::test::text_of(wide)).at("vector_loops") == "AVX-512");
+  } else {
+    CHECK(avx512.status == 2);
+    CHECK_THAT(avx512.output, Catch::Contains("--vector-loops avx512: this CPU lacks AVX-512"));
+    CHECK(sonomap::test::nothing_written(wide));
+  }
+
+  // A name that is no set of loops is bad input.
+  const auto unknown = run_sonomap({"-q", "bench", "render", "--frames", "1", "--vector-loops", "sse9"});
+  CHECK(unknown.status == 2);
+  CHECK_THAT(unknown.output, Catch::Contains("--vector-loops"));
 }
