@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `sonomap bench map` end to end on the smoke scene: every mapper has every stage timed, the
 // Open3D reference surface lies where our TSDF's does (an independent implementation, same
-// frames), bad input exits 2 writing nothing, and
-// the vectorised loops asked for are the ones timed. No timing is asserted.
+// frames), bad input exits 2 writing nothing, and the vectorised loops asked for are the ones
+// timed. No timing is asserted.
 #include "cli_support.hpp"
 #include "test_scenario_files.hpp"
 
