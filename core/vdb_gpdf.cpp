@@ -35,10 +35,12 @@ void require(bool ok, const std::string& what) {
 }
 
 // Stage "fusion": writes the frame's updates (one per voxel) into `frame_sums` as (sum of
-// w d, sum of w), then blends each touched voxel once by the fusion rule.
-void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& updates,
-                  FusedGrid& fused, DistanceWeightGrid& frame_sums) {
+// w d, sum of w), then blends each touched voxel once by the fusion rule; an update on the
+// free side stamps its voxel with the frame's time `now` in `seen_free_at`.
+void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& updates, float now,
+                  FusedGrid& fused, DistanceWeightGrid& frame_sums, openvdb::FloatGrid& seen_free_at) {
   auto sums = frame_sums.getAccessor();
+  auto free_at = seen_free_at.getAccessor();
   auto acc = fused.grid().getAccessor();
   const float vacated_below = static_cast<float>(-kVacatedVoxels * config.global_voxel);
   for (const QueryUpdate& u : updates) {
@@ -58,6 +60,7 @@ void fuse_updates(const VdbGpdfConfig& config, const std::vector<QueryUpdate>& u
     // wall behind until then. (Seen from its other side, a wall thinner than the behind
     // votes' reach is entered the same way, and the later view's surface wins.)
     const bool arrived = old[0] < 0.0f && u.seen_inside;
+    if (u.distance < 0.0f) free_at.setValue(u.voxel, now);
     acc.setValue(u.voxel, fused.weighted_average(openvdb::Vec2s(old[0], vacated || arrived ? 0.0f : old[1]), sum));
   }
 }
@@ -146,8 +149,12 @@ void VdbGpdf::integrate(const Frame& frame) {
   DistanceWeightGrid frame_sums(openvdb::Vec2s(0.0f, 0.0f));
   timed(times_, "voxelise", [&] { gpdf::voxelise(config_, frame, view, local); });
   timed(times_, "local_gps", [&] { gpdf::train_local_gps(config_.gp_params(), local); });
-  timed(times_, "query_points", [&] { updates = gpdf::query_updates(config_, local, view, fused_.grid(), origin); });
-  timed(times_, "fusion", [&] { fuse_updates(config_, updates, fused_, frame_sums); });
+  timed(times_, "query_points", [&] {
+    updates = gpdf::query_updates(config_, local, view, {fused_.grid(), seen_free_at_}, frame.time, origin);
+  });
+  timed(times_, "fusion", [&] {
+    fuse_updates(config_, updates, static_cast<float>(frame.time), fused_, frame_sums, seen_free_at_);
+  });
   timed(times_, "g_gpdf", [&] { update_global_field(frame_sums); });
   times_.stages.emplace_back("total", ms_since(t_start));
 }
@@ -267,7 +274,7 @@ void VdbGpdf::query(const std::vector<Eigen::Vector3f>& points,
 }
 
 size_t VdbGpdf::memory_bytes() const {
-  size_t bytes = FusedGridMapper::memory_bytes();
+  size_t bytes = FusedGridMapper::memory_bytes() + seen_free_at_.memUsage();
   for (const auto& kv : global_) {
     const size_t n = kv.second->crossings.size();
     bytes += sizeof(GlobalLeaf) + n * sizeof(Eigen::Vector3f);

@@ -11,6 +11,7 @@
 #include "core/mapper.hpp"
 #include "core/marching_cubes.hpp"
 
+#include <limits>
 #include <memory>
 #include <unordered_map>
 
@@ -86,6 +87,9 @@ class VdbGpdf final : public FusedGridMapper {
   VdbGpdfConfig config_;
   std::unordered_map<openvdb::Coord, std::unique_ptr<GlobalLeaf>, CoordHash> global_;
   StageTimes times_;
+  // Per global voxel the time (Frame::time, s) a frame last put it on the free side; never:
+  // the lowest float. The arrival rule tells fresh free space from stale by it (updates.cpp).
+  openvdb::FloatGrid seen_free_at_{std::numeric_limits<float>::lowest()};
 };
 
 }  // namespace sonomap

@@ -24,10 +24,17 @@ struct QueryUpdate {
   bool seen_inside = false;  // inside by its votes, and an object arrived there (arrival_seen)
 };
 
+// The map as it was before the frame: the fused values, and per voxel the time a frame last put
+// it on the free side (VdbGpdf::seen_free_at_).
+struct MapBefore {
+  const DistanceWeightGrid& fused;
+  const openvdb::FloatGrid& seen_free_at;
+};
+
 // Stage "query_points": every local leaf's votes, counted per global voxel (cast_votes), then one
-// GP query per voxel (in parallel, each voxel writing its own slot).
+// GP query per voxel (in parallel, each voxel writing its own slot). `now`: the frame's time.
 std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalFrame& local,
-                                       const DepthView& view, const DistanceWeightGrid& fused,
+                                       const DepthView& view, const MapBefore& map, double now,
                                        const Eigen::Vector3d& origin);
 
 }  // namespace sonomap::gpdf
