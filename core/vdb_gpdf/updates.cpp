@@ -86,9 +86,11 @@ bool measured_surface_is_new(const VdbGpdfConfig& config, const UpdateLookups& a
 // measured surface"; but the panel is one the map holds already.
 bool arrival_seen(const VdbGpdfConfig& config, const UpdateLookups& at, const openvdb::Coord& voxel,
                   const DepthView::Sight& sight) {
-  const bool freed_recently = at.now - at.seen_free_at.getValue(voxel) <= kRecentlyFreeSeconds;
+  // The stamp is read last, and only for centres deep behind: arrival() is asked of every
+  // voxel a frame puts inside.
+  auto freed_recently = [&] { return at.now - at.seen_free_at.getValue(voxel) <= kRecentlyFreeSeconds; };
   return at.view.seen_behind(sight, kArrivedVoxels * config.global_voxel) &&
-         (freed_recently || !at.view.seen_behind(sight, kStaleArrivedVoxels * config.global_voxel)) &&
+         (!at.view.seen_behind(sight, kStaleArrivedVoxels * config.global_voxel) || freed_recently()) &&
          measured_surface_is_new(config, at, sight);
 }
 
