@@ -153,9 +153,10 @@ void RunResults::add_timings(int frame, const FrameTimes& times) {
   for (const auto& name : timing_columns_) {
     auto it = std::find_if(times.begin(), times.end(), [&](auto& t) { return t.first == name; });
     timings_ << ',' << (it != times.end() ? fmt::format("{:.3f}", it->second) : "");
-    if (it != times.end()) timing_samples_[name].push_back(it->second);
+    if (it != times.end()) timing_samples_[name].push_back({frame, it->second});
   }
   timings_ << '\n';
+  frames_run_ = std::max(frames_run_, frame + 1);
 }
 
 void RunResults::fill_metrics(RunSummary& summary, bool edf_enabled) const {
@@ -178,7 +179,7 @@ void RunResults::finish(const RunSummary& summary, const Mapper& mapper) {
   if (!triangles.empty()) save_mesh_ply(dir_ / "map.ply", vertices, triangles);
   write_result_file(dir_ / "summary.json", nlohmann::json(summary).dump(2) + "\n");
   write_result_file(dir_ / "timings.json",
-                    nlohmann::json(summarise_timings(timing_samples_)).dump(2) + "\n");
+                    nlohmann::json(summarise_timings(timing_samples_, frames_run_)).dump(2) + "\n");
 }
 
 void write_edf_csv(const fs::path& file, const FrameView& f) {

@@ -116,7 +116,8 @@ class RunResults {
   std::vector<eval::RasterMetrics> circle_series_, cylinder_series_, edf_series_;
   std::vector<SlipStats> slip_series_;
   std::vector<std::string> timing_columns_;
-  std::map<std::string, std::vector<double>> timing_samples_;
+  std::map<std::string, std::vector<TimedFrame>> timing_samples_;
+  int frames_run_ = 0;
 };
 
 // edf.csv: per bin of the frame (the final one), the map's circle next to the EDF's.

@@ -9,6 +9,9 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <optional>
+#include <tuple>
 #include <utility>
 
 namespace fs = std::filesystem;
@@ -161,11 +164,40 @@ EdfSummary EdfSummary::of(const std::vector<SlipStats>& frames) {
   return e;
 }
 
-RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples) {
+namespace {
+
+// The median of the times of the frames in [first, last] (the upper one of an even count), and
+// how many there were; none when there were none.
+std::optional<std::pair<double, std::size_t>> median_between(const std::vector<TimedFrame>& samples, int first,
+                                                              int last) {
+  std::vector<double> values;
+  for (const TimedFrame& s : samples)
+    if (s.frame >= first && s.frame <= last) values.push_back(s.ms);
+  if (values.empty()) return std::nullopt;
+  std::sort(values.begin(), values.end());
+  return std::make_pair(values[values.size() / 2], values.size());
+}
+
+std::optional<StageGrowth> growth_of(const std::vector<TimedFrame>& samples, int frames_run) {
+  if (frames_run < 3 * kGrowthWindow) return std::nullopt;
+  StageGrowth g{kGrowthWindow, 2 * kGrowthWindow - 1, frames_run - kGrowthWindow, frames_run - 1};
+  const auto early = median_between(samples, g.early_first, g.early_last);
+  const auto late = median_between(samples, g.late_first, g.late_last);
+  if (!early || !late || !(early->first > 0.0)) return std::nullopt;
+  std::tie(g.early_median_ms, g.early_samples) = *early;
+  std::tie(g.late_median_ms, g.late_samples) = *late;
+  g.late_over_early = g.late_median_ms / g.early_median_ms;
+  return g;
+}
+
+}  // namespace
+
+RunTimings summarise_timings(const std::map<std::string, std::vector<TimedFrame>>& samples, int frames_run) {
   RunTimings timings;
-  for (auto& [name, values] : samples) {
-    std::sort(values.begin(), values.end());
-    timings[name] = {values[values.size() / 2], values.size()};
+  for (const auto& [name, stage] : samples) {
+    const auto all = median_between(stage, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+    if (!all) continue;
+    timings[name] = {all->first, all->second, growth_of(stage, frames_run)};
   }
   return timings;
 }
@@ -308,10 +340,32 @@ void from_json(const json& j, RunSummary& s) {
 
 void to_json(json& j, const StageTiming& t) {
   j = json{{"median_ms", t.median_ms}, {"samples", t.samples}};
+  if (!t.growth) return;
+  const StageGrowth& g = *t.growth;
+  j["growth"] = json{{"early_frames", {g.early_first, g.early_last}},
+                     {"early_median_ms", g.early_median_ms},
+                     {"early_samples", g.early_samples},
+                     {"late_frames", {g.late_first, g.late_last}},
+                     {"late_median_ms", g.late_median_ms},
+                     {"late_samples", g.late_samples},
+                     {"late_over_early", g.late_over_early}};
 }
 void from_json(const json& j, StageTiming& t) {
   j.at("median_ms").get_to(t.median_ms);
   j.at("samples").get_to(t.samples);
+  t.growth.reset();
+  if (!j.contains("growth")) return;  // a short run's, or an older file's
+  const json& g = j.at("growth");
+  StageGrowth& out = t.growth.emplace();
+  g.at("early_frames").at(0).get_to(out.early_first);
+  g.at("early_frames").at(1).get_to(out.early_last);
+  g.at("late_frames").at(0).get_to(out.late_first);
+  g.at("late_frames").at(1).get_to(out.late_last);
+  g.at("early_median_ms").get_to(out.early_median_ms);
+  g.at("late_median_ms").get_to(out.late_median_ms);
+  g.at("early_samples").get_to(out.early_samples);
+  g.at("late_samples").get_to(out.late_samples);
+  g.at("late_over_early").get_to(out.late_over_early);
 }
 
 RunSummary read_run_summary(const fs::path& dir) {

@@ -117,13 +117,33 @@ struct RunSummary {
   std::vector<eval::MovedObjectClearing> moved_objects;
 };
 
-// timings.json: per stage, the median wall time over the frames it ran in.
+// How a stage's time grew over a long run: its median over the run's last kGrowthWindow
+// frames against frames kGrowthWindow to 2 kGrowthWindow - 1 (the first kGrowthWindow are the
+// map's start-up). For the room's 2700 frames: frames 2600-2699 against 100-199.
+inline constexpr int kGrowthWindow = 100;
+struct StageGrowth {
+  int early_first = 0, early_last = 0, late_first = 0, late_last = 0;  // frames, inclusive
+  double early_median_ms = 0.0, late_median_ms = 0.0;
+  std::size_t early_samples = 0, late_samples = 0;  // the frames of each window it ran in
+  double late_over_early = 0.0;
+};
+
+// timings.json: per stage, the median wall time over the frames it ran in and, in a run of
+// 3 kGrowthWindow frames or more, its growth (where it ran in both windows, in a measurable
+// time at the start).
 struct StageTiming {
   double median_ms = 0.0;
   std::size_t samples = 0;
+  std::optional<StageGrowth> growth;
 };
 using RunTimings = std::map<std::string, StageTiming>;
-RunTimings summarise_timings(std::map<std::string, std::vector<double>> samples);
+struct TimedFrame {
+  int frame = 0;
+  double ms = 0.0;
+};
+// `samples`: per stage, the frames it ran in (in any order) and their times; `frames_run`:
+// the number of frames the run went through (frames 0 to frames_run - 1).
+RunTimings summarise_timings(const std::map<std::string, std::vector<TimedFrame>>& samples, int frames_run);
 
 // FNV-1a over the canonical JSON of a configuration: a short, stable hash.
 std::string config_hash(const nlohmann::json& config);

@@ -11,8 +11,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
+#include <map>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -20,18 +24,19 @@ using sonomap::test::ScratchDir;
 
 namespace {
 
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream s(line);
+  for (std::string f; std::getline(s, f, ',');) fields.push_back(f);
+  return fields;
+}
+
 // The last line's field in `column` of a CSV with a header.
 double last_row_value(const fs::path& csv, const std::string& column) {
   std::istringstream in(sonomap::test::text_of(csv));
   std::string header, line, last;
   std::getline(in, header);
   while (std::getline(in, line)) last = line;
-  auto split = [](const std::string& text) {
-    std::vector<std::string> fields;
-    std::stringstream s(text);
-    for (std::string f; std::getline(s, f, ',');) fields.push_back(f);
-    return fields;
-  };
   const auto names = split(header), values = split(last);
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == column) return std::stod(values.at(i));
@@ -93,4 +98,92 @@ TEST_CASE("a summary of another schema, or with a field missing, is refused nami
   CHECK_THROWS_WITH(read_run_summary(scratch.path() / "partial"),
                     Contains("partial/summary.json") && Contains("cylinder"));
   CHECK_THROWS_WITH(read_run_summary(scratch.path() / "absent"), Contains("absent/summary.json"));
+}
+
+namespace {
+
+// Per frame of timings.csv, the value of `column` (frames where it is empty left out).
+std::map<int, double> column_by_frame(const fs::path& csv, const std::string& column) {
+  std::istringstream in(sonomap::test::text_of(csv));
+  std::string header;
+  std::getline(in, header);
+  const std::vector<std::string> names = split(header);
+  const auto at = std::find(names.begin(), names.end(), column);
+  REQUIRE(at != names.end());
+  const std::size_t c = static_cast<std::size_t>(at - names.begin());
+  std::map<int, double> values;
+  for (std::string line; std::getline(in, line);) {
+    const std::vector<std::string> fields = split(line);
+    if (c < fields.size() && !fields[c].empty()) values[std::stoi(fields[0])] = std::stod(fields[c]);
+  }
+  return values;
+}
+
+// The upper median of the values at frames [first, last], and how many there were.
+std::pair<double, std::size_t> median_at(const std::map<int, double>& values, int first, int last) {
+  std::vector<double> v;
+  for (const auto& [frame, ms] : values)
+    if (frame >= first && frame <= last) v.push_back(ms);
+  REQUIRE(!v.empty());
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return {v[v.size() / 2], v.size()};
+}
+
+}  // namespace
+
+TEST_CASE("a run of 300 frames gives each stage's growth in timings.json: the median of frames 200-299 "
+          "against 100-199, as timings.csv shows them",
+          "[run_summary]") {
+  ScratchDir scratch("run-summary-growth");
+  auto o = sonomap::test::smoke_run(scratch.path() / "out", "depth_only", 300);
+  o.every = 50;  // rasters at frames 0, 50, ..., 250 and the last, 299
+  sonomap::harness::run_scenario(o);
+  const auto timings = sonomap::harness::read_run_timings(o.out);
+  std::ifstream in(o.out / "timings.json");
+  CHECK(json(timings) == json::parse(in));  // nothing lost on the way back
+  for (const std::string stage : {"integrate", "raster"}) {
+    CAPTURE(stage);
+    const auto csv = column_by_frame(o.out / "timings.csv", stage + "_ms");
+    const auto& growth = timings.at(stage).growth;
+    REQUIRE(growth);
+    CHECK(growth->early_first == 100);
+    CHECK(growth->early_last == 199);
+    CHECK(growth->late_first == 200);
+    CHECK(growth->late_last == 299);
+    const auto [early, early_n] = median_at(csv, 100, 199);
+    const auto [late, late_n] = median_at(csv, 200, 299);
+    CHECK(growth->early_samples == early_n);
+    CHECK(growth->late_samples == late_n);
+    // timings.csv rounds to a microsecond
+    CHECK(growth->early_median_ms == Approx(early).margin(5e-4));
+    CHECK(growth->late_median_ms == Approx(late).margin(5e-4));
+    CHECK(growth->late_over_early == Approx(growth->late_median_ms / growth->early_median_ms));
+  }
+  CHECK(timings.at("integrate").growth->early_samples == 100);  // every frame is integrated
+  CHECK(timings.at("raster").growth->early_samples == 2);       // frames 100 and 150
+  CHECK(timings.at("raster").growth->late_samples == 3);        // 200, 250 and 299
+}
+
+TEST_CASE("growth needs 300 frames, the stage in both windows, and a measurable time at the start",
+          "[run_summary]") {
+  using sonomap::harness::summarise_timings;
+  using sonomap::harness::TimedFrame;
+  std::vector<TimedFrame> every_frame, late_only, zero_early;
+  for (int f = 0; f < 300; ++f) {
+    every_frame.push_back({f, f < 200 ? 10.0 : 12.0});
+    if (f >= 200) late_only.push_back({f, 1.0});
+    zero_early.push_back({f, f < 200 ? 0.0 : 1.0});
+  }
+  const auto long_run = summarise_timings({{"a", every_frame}, {"b", late_only}, {"c", zero_early}}, 300);
+  REQUIRE(long_run.at("a").growth);
+  CHECK(long_run.at("a").growth->early_median_ms == 10.0);
+  CHECK(long_run.at("a").growth->late_median_ms == 12.0);
+  CHECK(long_run.at("a").growth->late_over_early == Approx(1.2));
+  CHECK(long_run.at("a").median_ms == 10.0);  // 200 of the 300 frames took 10 ms
+  CHECK(long_run.at("a").samples == 300);
+  CHECK_FALSE(long_run.at("b").growth);
+  CHECK_FALSE(long_run.at("c").growth);
+  const auto short_run = summarise_timings({{"a", every_frame}}, 299);
+  CHECK_FALSE(short_run.at("a").growth);
+  CHECK(json(short_run.at("a")).contains("growth") == false);
 }
