@@ -191,13 +191,20 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
       k(j, i) = v;
     }
   }
-  const Eigen::LLT<Eigen::MatrixXd> llt(k);
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(k);  // in place: no copy of K per GP
   const Eigen::VectorXd alpha = llt.solve(Eigen::VectorXd::Ones(n));
   alpha_lanes_.assign(padded, 0.0f);
   for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha[i]);
+  // A mean of 0 or below has no log: predict() then takes the distance to the nearest point,
+  // here the point itself.
+  point_distances_.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const double f = 1.0 - params_.noise * alpha[i];
+    point_distances_[i] = f > 0.0 ? static_cast<float>(distance_of(std::log(f))) : 0.0f;
+  }
   // The Cholesky factor is kept for the variance only, in float and packed: a quarter of the
   // double matrix (a mapped room's global GPs held 23 MB of factors in double).
-  const Eigen::MatrixXd& factor = llt.matrixLLT();  // L in its lower triangle
+  const auto& factor = llt.matrixLLT();  // L in its lower triangle (in k)
   lower_.resize(static_cast<size_t>(n) * (n + 1) / 2);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j <= i; ++j) lower_[row_start(i) + j] = static_cast<float>(factor(i, j));
@@ -205,7 +212,13 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
 
 size_t SurfaceGp::memory_bytes() const {
   return points_.capacity() * sizeof(Eigen::Vector3f) +
-         (xs_.capacity() + ys_.capacity() + zs_.capacity() + alpha_lanes_.capacity() + lower_.capacity()) * sizeof(float);
+         (xs_.capacity() + ys_.capacity() + zs_.capacity() + alpha_lanes_.capacity() + lower_.capacity() +
+          point_distances_.capacity()) *
+             sizeof(float);
+}
+
+double SurfaceGp::distance_of(double log_f) const {
+  return params_.kernel == GpKernel::RevertingSE ? std::sqrt(2.0 * std::abs(log_f) / a_) : std::abs(log_f) / a_;
 }
 
 GpPrediction SurfaceGp::predict(const Eigen::Vector3d& x, bool with_variance, bool with_gradient) const {
@@ -259,7 +272,7 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
     return out;
   }
   const double log_f = static_cast<double>(max_expo) + std::log(s);
-  out.distance = se ? std::sqrt(2.0 * std::abs(log_f) / a_) : std::abs(log_f) / a_;
+  out.distance = distance_of(log_f);
   if constexpr (kGradient) {
     const Eigen::Vector3d g = -(se ? a_ : a_ * a_) * Eigen::Vector3d(lane_sum(gx), lane_sum(gy), lane_sum(gz));
     const double gn = g.norm();

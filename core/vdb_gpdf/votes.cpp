@@ -36,7 +36,9 @@ class LeafQueries {
 
   std::vector<Vote> votes;
 
-  void add(const Eigen::Vector3d& p) {
+  // Source p (its leaf's training point `trained` where it is one: the leaf's sources begin with
+  // them, in order).
+  void add(const Eigen::Vector3d& p, std::optional<size_t> trained) {
     Eigen::Vector3d u = origin_ - p;
     const double range = u.norm();
     if (!(range > 0.0)) return;
@@ -48,9 +50,9 @@ class LeafQueries {
     const Eigen::Vector3d facing = normal.isZero() ? u : normal;  // the tangent plane's normal
     const openvdb::Coord own = voxel_of(p, vg_);
     // The GP's own distance at p (its surface fit misses p by that much) moves the value
-    // inward, as the first-order value at the centre: -d(p) - facing . (centre - p).
-    const GpPrediction at_p = gp_.predict(p, false, false);  // p lies in this leaf: its GP is the nearest
-    const double d = at_p.valid ? at_p.distance : 0.0;
+    // inward, as the first-order value at the centre: -d(p) - facing . (centre - p). p lies in
+    // this leaf: its GP is the nearest.
+    const double d = trained ? gp_.distance_at_point(*trained) : distance_at(p);
     cast(own, kSurface, static_cast<float>(-d - facing.dot(voxel_centre(own, vg_) - p)));
     const bool trusted = normal.dot(u) > kMinNormalDotRay;  // zero normal: not trusted
     if (lateral_ && trusted) add_lateral(own, p, facing, d);
@@ -65,6 +67,11 @@ class LeafQueries {
   }
 
  private:
+  double distance_at(const Eigen::Vector3d& p) const {
+    const GpPrediction at_p = gp_.predict(p, false, false);
+    return at_p.valid ? at_p.distance : 0.0;
+  }
+
   // How far a ring's neighbourhood is widened: past the next ring of a lidar whose rings are up
   // to kRingSpacingDeg apart, beyond the ball, within the leaves around (one leaf's width).
   double ring_reach(double range) const {
@@ -329,7 +336,10 @@ void cast_votes(const VdbGpdfConfig& config, const LocalFrame& local, const Dept
   parallel_for_each_index(leaves, [&](size_t leaf) {
     LeafQueries queries(config, local, fused, leaf, origin, view);
     queries.votes.reserve(local.sources[leaf].size() * kVotesPerSource);
-    for (const auto& p : local.sources[leaf]) queries.add(p.cast<double>());
+    const std::vector<Eigen::Vector3f>& sources = local.sources[leaf];
+    const size_t trained = local.training[leaf].size();  // the first sources (add_sparse_sources)
+    for (size_t i = 0; i < sources.size(); ++i)
+      queries.add(sources[i].cast<double>(), i < trained ? std::optional<size_t>(i) : std::nullopt);
     votes[leaf] = std::move(queries.votes);
   });
   openvdb::MaskGrid beside_rays(false);

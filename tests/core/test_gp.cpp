@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -119,6 +120,29 @@ TEST_CASE("GP: a point with 1, 3 and 5 training points (not whole SIMD vectors) 
     gp.train(points, GpParams{});
     const Eigen::Vector3d x(0.0, 0.0, 0.03);
     CHECK(gp.predict(x, false).distance == Approx(reference_distance(points, GpParams{}, x)).margin(1e-4));
+  }
+}
+
+TEST_CASE("GP: at its own training points, the distance from the training solve is the formula's in double "
+          "within 1 micrometre",
+          "[gp]") {
+  // A bumpy patch (heights 1.2 +- 6 mm), so that the fit misses its points by a measurable distance.
+  std::vector<Eigen::Vector3f> bumpy = plane_patch();
+  for (size_t i = 0; i < bumpy.size(); ++i) bumpy[i].z() += 0.006f * static_cast<float>(std::sin(1.7 * i));
+  for (GpKernel kernel : {GpKernel::RevertingSE, GpKernel::LogGpisMatern32}) {
+    GpParams params;
+    params.kernel = kernel;
+    SurfaceGp gp;
+    gp.train(bumpy, params);
+    double largest = 0.0;
+    for (size_t i = 0; i < bumpy.size(); ++i) {
+      const Eigen::Vector3d x = bumpy[i].cast<double>();
+      const double expected = reference_distance(bumpy, params, x);
+      largest = std::max(largest, expected);
+      CHECK(gp.distance_at_point(i) == Approx(expected).margin(1e-6));
+      CHECK(gp.distance_at_point(i) == Approx(gp.predict(x, false).distance).margin(1e-4));  // the query path's
+    }
+    CHECK(largest > 1e-4);  // not only zeros compared
   }
 }
 
