@@ -73,20 +73,28 @@ struct LocalGps {
     std::array<int, 26> found{};
   };
 
+  // One task's reads of the index, kept from query to query: its accessor has the node of the
+  // last query's leaf cached (a fresh one descended the tree from its root, about 60
+  // instructions, for each of a frame's 30,000 voxels), and the leaves around the last query's
+  // home leaf are kept (consecutive voxels of a vote leaf mostly share their local leaf: the 26
+  // look-ups of a home without a leaf were a quarter of the nearest leaf's cost). Not copied:
+  // `around` may point into itself.
+  struct Lookup {
+    explicit Lookup(const openvdb::Int32Tree& index) : at(index) {}
+    Lookup(const Lookup&) = delete;
+    Lookup& operator=(const Lookup&) = delete;
+    IndexAccessor at;
+    openvdb::Coord home = openvdb::Coord::max();
+    int own = -1;  // the home's leaf, or -1
+    Around around;
+  };
+
   // The nearest leaf to q (its own, else the nearest around it, else the nearest of all; ties
-  // to the lower index) and the leaves around q's.
-  int nearest(const Eigen::Vector3d& q, Around& around) const {
+  // to the lower index); `lookup.around` then holds the leaves around q's.
+  int nearest(const Eigen::Vector3d& q, Lookup& lookup) const {
     const openvdb::Coord home = leaf_origin_of(voxel_of(q, voxel));
-    const IndexAccessor at(index);
-    if (const int own = at.getValue(leaf_key_of(home)); own >= 0) {
-      around.begin = neighbours[own].data();
-      around.end = around.begin + neighbours[own].size();
-      return own;
-    }
-    int* next = around.found.data();
-    for_each_neighbour(at, home, [&](int j) { *next++ = j; });
-    around.begin = around.found.data();
-    around.end = next;
+    if (home != lookup.home) look_around(home, lookup);
+    if (lookup.own >= 0) return lookup.own;
     int best = -1;
     double best_d2 = std::numeric_limits<double>::infinity();
     auto consider = [&](int i) {
@@ -96,10 +104,25 @@ struct LocalGps {
         best = i;
       }
     };
-    std::for_each(around.begin, around.end, consider);
+    std::for_each(lookup.around.begin, lookup.around.end, consider);
     if (best >= 0) return best;
     for (int i = 0; i < static_cast<int>(centres.size()); ++i) consider(i);
     return best;
+  }
+
+  void look_around(const openvdb::Coord& home, Lookup& lookup) const {
+    Around& around = lookup.around;
+    lookup.home = home;
+    lookup.own = lookup.at.getValue(leaf_key_of(home));
+    if (lookup.own >= 0) {
+      around.begin = neighbours[lookup.own].data();
+      around.end = around.begin + neighbours[lookup.own].size();
+      return;
+    }
+    int* next = around.found.data();
+    for_each_neighbour(lookup.at, home, [&](int j) { *next++ = j; });
+    around.begin = around.found.data();
+    around.end = next;
   }
 
   // The smallest distance the local GPs predict at q. Each GP knows only its own patch, so its
@@ -108,16 +131,16 @@ struct LocalGps {
   // in free space and the edge is carved off. Besides the nearest GP, every leaf around q's
   // whose training points' box is nearer than the best distance so far (the box, not the
   // leaf's cube: most neighbours are then skipped unasked).
-  GpPrediction smallest(const Eigen::Vector3d& q, bool with_variance) const {
+  GpPrediction smallest(const Eigen::Vector3d& q, bool with_variance, Lookup& lookup) const {
     GpPrediction best;
     auto consider = [&](int i) {
       const GpPrediction p = gps[i].predict(q, with_variance, false);
       if (p.valid && (!best.valid || p.distance < best.distance)) best = p;
     };
-    Around around;
-    const int first = nearest(q, around);
+    const int first = nearest(q, lookup);
     if (first < 0) return best;
     consider(first);
+    const Around& around = lookup.around;
     for (const int* i = around.begin; i != around.end; ++i)
       if (*i != first && (!best.valid || bounds[*i].exteriorDistance(q) < best.distance)) consider(*i);
     return best;

@@ -52,6 +52,7 @@ constexpr double kInsideCapVoxels = 0.5;
 // points, its depth image and the map as it was before the frame (one per task: accessors).
 struct UpdateLookups {
   const LocalGps& locals;
+  mutable LocalGps::Lookup gp_lookup;  // its caches change as the voxels are visited
   ReadAccessor<openvdb::MaskTree> near;
   const DepthView& view;
   ReadAccessor<DistanceWeightGrid::TreeType> map;
@@ -166,7 +167,7 @@ bool voxel_update(const VdbGpdfConfig& config, const openvdb::Coord& voxel, Vote
   // (or for the variance that inverse-variance fusion weights by).
   double distance = 0.0, variance = config.variance_on_surface;
   if (inside + free > 0 || config.inverse_variance_fusion) {
-    const GpPrediction pred = at.locals.smallest(centre, config.inverse_variance_fusion);
+    const GpPrediction pred = at.locals.smallest(centre, config.inverse_variance_fusion, at.gp_lookup);
     if (!pred.valid) return false;
     distance = pred.distance;
     variance = pred.variance;
@@ -193,8 +194,13 @@ std::vector<QueryUpdate> query_updates(const VdbGpdfConfig& config, const LocalF
   votes.counts.tree().getNodes(vote_leaves);
   std::vector<std::vector<QueryUpdate>> per_leaf(vote_leaves.size());
   parallel_for_each_index(vote_leaves.size(), [&](size_t i) {
-    const UpdateLookups lookups{local.gps,          read_accessor(local.near),        view,
-                                read_accessor(map.fused), read_accessor(map.seen_free_at), now};
+    const UpdateLookups lookups{local.gps,
+                                LocalGps::Lookup(local.gps.index),
+                                read_accessor(local.near),
+                                view,
+                                read_accessor(map.fused),
+                                read_accessor(map.seen_free_at),
+                                now};
     const auto surface_acc = read_accessor(votes.surface);
     const auto lateral_acc = read_accessor(votes.lateral);
     QueryUpdate update;
