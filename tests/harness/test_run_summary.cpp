@@ -7,6 +7,7 @@
 
 #include "harness/app/run.hpp"
 #include "harness/formats/run_summary.hpp"
+#include "harness/report/rollup.hpp"
 #include "harness/support/errors.hpp"
 
 #include <nlohmann/json.hpp>
@@ -14,7 +15,6 @@
 #include <algorithm>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -24,23 +24,17 @@ using sonomap::test::ScratchDir;
 
 namespace {
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream s(line);
-  for (std::string f; std::getline(s, f, ',');) fields.push_back(f);
-  return fields;
+// A CSV with a header, read by the roll-up's table (the reader `report` and the gates use).
+sonomap::harness::RollupTable csv_table(const fs::path& csv) {
+  return sonomap::harness::RollupTable::parse(sonomap::test::text_of(csv));
 }
 
 // The last line's field in `column` of a CSV with a header.
 double last_row_value(const fs::path& csv, const std::string& column) {
-  std::istringstream in(sonomap::test::text_of(csv));
-  std::string header, line, last;
-  std::getline(in, header);
-  while (std::getline(in, line)) last = line;
-  const auto names = split(header), values = split(last);
-  for (std::size_t i = 0; i < names.size(); ++i)
-    if (names[i] == column) return std::stod(values.at(i));
-  throw std::runtime_error("no column " + column);
+  const auto table = csv_table(csv);
+  const int c = table.column(column);
+  if (c < 0 || table.rows.empty()) throw std::runtime_error("no column " + column);
+  return table.number(table.rows.back(), c);
 }
 
 }  // namespace
@@ -104,18 +98,12 @@ namespace {
 
 // Per frame of timings.csv, the value of `column` (frames where it is empty left out).
 std::map<int, double> column_by_frame(const fs::path& csv, const std::string& column) {
-  std::istringstream in(sonomap::test::text_of(csv));
-  std::string header;
-  std::getline(in, header);
-  const std::vector<std::string> names = split(header);
-  const auto at = std::find(names.begin(), names.end(), column);
-  REQUIRE(at != names.end());
-  const std::size_t c = static_cast<std::size_t>(at - names.begin());
+  const auto table = csv_table(csv);
+  const int c = table.column(column), frame = table.column("frame");
+  REQUIRE(c >= 0);
   std::map<int, double> values;
-  for (std::string line; std::getline(in, line);) {
-    const std::vector<std::string> fields = split(line);
-    if (c < fields.size() && !fields[c].empty()) values[std::stoi(fields[0])] = std::stod(fields[c]);
-  }
+  for (const auto& row : table.rows)
+    if (!table.cell(row, c).empty()) values[static_cast<int>(table.number(row, frame))] = table.number(row, c);
   return values;
 }
 
