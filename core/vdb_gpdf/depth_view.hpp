@@ -3,6 +3,7 @@
 // point lies in front of or behind what the sensor measured. Internal to core/vdb_gpdf*.
 #pragma once
 
+#include "core/mapper.hpp"
 #include "core/parallel.hpp"
 #include "core/pixel.hpp"
 #include "core/types.hpp"
@@ -338,6 +339,32 @@ class DepthView {
            0;
   }
 
+  // Whether near_silhouette() may hold anywhere in a world box: false when the box's projection,
+  // widened by a pixel, covers no silhouette tile, or lies outside the image. Exact as a
+  // pre-test: in front of the camera a box projects inside the rectangle of its corners'
+  // projections, and the pixel a margin covers rounding. A cloud, or a box reaching behind the
+  // camera, answers true. One test per local leaf instead of a projection per local voxel.
+  bool may_touch_silhouette(const Eigen::AlignedBox3d& world) const {
+    if (!image_) return true;
+    const PinholeIntrinsics& k = frame_.intrinsics;
+    double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c = camera_T_world_ * world.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
+      if (!(c.z() > 0.0)) return true;
+      const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
+      u_min = std::min(u_min, u), u_max = std::max(u_max, u);
+      v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+    }
+    if (!(std::isfinite(u_min) && std::isfinite(u_max) && std::isfinite(v_min) && std::isfinite(v_max))) return true;
+    const double last_u = frame_.width - 1, last_v = frame_.height - 1;
+    if (u_max + 1.0 < 0.0 || v_max + 1.0 < 0.0 || u_min - 1.0 > last_u || v_min - 1.0 > last_v) return false;
+    auto tile = [](double pixel, double last) {
+      return static_cast<int>(std::clamp(pixel, 0.0, last)) / kSilhouetteTile;
+    };
+    return silhouette_tiles_in(tile(std::floor(u_min - 1.0), last_u), tile(std::ceil(u_max + 1.0), last_u),
+                               tile(std::floor(v_min - 1.0), last_v), tile(std::ceil(v_max + 1.0), last_v)) > 0;
+  }
+
   // In the image, and its own pixel (or cell) measured a surface more than `margin` farther.
   bool seen_past(const Sight& s, double margin) const {
     const float d = measured_depth(s);
@@ -397,6 +424,25 @@ class DepthView {
       for (size_t y = ty > 0 ? ty - 1 : 0; y <= std::min(ty + 1, down - 1); ++y)
         for (size_t tx = 0; tx < across; ++tx) row[tx] |= widened[y * across + tx];
     });
+    count_silhouette_tiles(across, down);
+  }
+  // The silhouette tiles summed over every rectangle from the image's corner (a summed-area
+  // table, one row and column of zeros first), so that a rectangle's count costs four reads.
+  void count_silhouette_tiles(size_t across, size_t down) {
+    tiles_before_.assign((across + 1) * (down + 1), 0);
+    for (size_t ty = 0; ty < down; ++ty) {
+      int32_t in_row = 0;
+      for (size_t tx = 0; tx < across; ++tx) {
+        in_row += silhouette_tiles_[ty * across + tx] != 0;
+        tiles_before_[(ty + 1) * (across + 1) + tx + 1] = tiles_before_[ty * (across + 1) + tx + 1] + in_row;
+      }
+    }
+  }
+  // The silhouette tiles among tiles [tx0, tx1] x [ty0, ty1].
+  int32_t silhouette_tiles_in(int tx0, int tx1, int ty0, int ty1) const {
+    const size_t stride = static_cast<size_t>(tiles_across_) + 1;
+    auto before = [&](int tx, int ty) { return tiles_before_[static_cast<size_t>(ty) * stride + static_cast<size_t>(tx)]; };
+    return before(tx1 + 1, ty1 + 1) - before(tx0, ty1 + 1) - before(tx1 + 1, ty0) + before(tx0, ty0);
   }
   // One row of tiles: every second pixel of every second row against the next such pixel right
   // and down (a step between two neighbours is a step between the two pixels around them), a
@@ -423,6 +469,7 @@ class DepthView {
   Eigen::Isometry3d camera_T_world_;
   bool image_;
   std::vector<uint8_t> silhouette_tiles_;  // images only
+  std::vector<int32_t> tiles_before_;      // count_silhouette_tiles
   int tiles_across_ = 0;
   // Frames without an image. (A std::optional here drew GCC 12's -Wmaybe-uninitialized on its
   // vector in the sanitizer build, a false report.)

@@ -239,6 +239,14 @@ void ask_for_sums(const PointSumGrid::TreeType::LeafNodeType& leaf) {
   for (auto v = leaf.cbeginValueOn(); v; ++v) __builtin_prefetch(sums + v.pos());
 }
 
+// The space a local leaf's centroids lie in: its cube, with a local voxel to spare on every side
+// (a centroid of float sums may round a hair past its voxel's face).
+Eigen::AlignedBox3d local_leaf_box(const openvdb::Coord& origin, double local_voxel) {
+  const Eigen::Vector3d low = Eigen::Vector3d(origin.x(), origin.y(), origin.z()) * local_voxel;
+  const Eigen::Vector3d spare = Eigen::Vector3d::Constant(local_voxel);
+  return {low - spare, low + Eigen::Vector3d::Constant(LeafCells::Leaf::DIM * local_voxel) + spare};
+}
+
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
 // centroids of every voxel_downsample-th occupied local voxel, or of every one in a cloud's
 // sparse leaf, then of the others on an edge that the sensor saw past; not the voxel centres:
@@ -268,6 +276,7 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
     ask_for_sums(*leaves[i]);
     std::optional<LocalVoxelsAround> around;
     std::vector<Eigen::Vector3f> at_edges;
+    const bool near_silhouette = view.may_touch_silhouette(local_leaf_box(leaves[i]->origin(), config.local_voxel));
     int k = 0;
     for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
       const Eigen::Vector3d c = centroid(*v);
@@ -277,7 +286,7 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
       if (k % stride == 0) {
         out.training[i].push_back(c.cast<float>());
         cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
-      } else if (at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config)) {
+      } else if (near_silhouette && at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config)) {
         at_edges.push_back(c.cast<float>());
         cells[i].trained.emplace_back(voxel_of(at_edges.back().cast<double>(), config.global_voxel));
       }
