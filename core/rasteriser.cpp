@@ -23,13 +23,13 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 // The first pass over a batch of points finds, for each, whether it counts, its range (the
 // square roots are cheaper eight at a time than one by one in the second pass), its bin
 // position by a fast arctangent and its row quotient. It is written without branches, over
-// plain arrays, so that the compiler vectorises it (core/vector_isa.hpp: a copy
+// plain arrays, reading the points' (x, y, z) floats where they lie (a copy of them into the
+// batch cost as many instructions as the pass itself), so that the compiler vectorises it (core/vector_isa.hpp: a copy
 // per instruction set; the top-level CMakeLists.txt gives the options it needs and why). The second
 // pass, one point at a time, places the points in their cells.
 constexpr size_t kBatch = 256;
 
 struct Batch {
-  double x[kBatch], y[kBatch], z[kBatch];  // the points, in the world
   float range[kBatch];                     // the horizontal range a cell records
   double bin_position[kBatch];             // fast atan2 / bin width, in [0, bins]
   double row_position[kBatch];             // (height - band_min) / row height
@@ -48,11 +48,12 @@ inline void to_body(const Rasteriser::Placement& at, double dx, double dy, doubl
   y = -at.sin_heading * dx + at.cos_heading * dy;
 }
 
-SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement, Batch& b) {
+SONOMAP_VECTOR_LOOP void locate(size_t n, const float* xyz, const Rasteriser::Placement& placement, Batch& b) {
   const Rasteriser::Placement at = placement;  // locals: a load inside a select could trap
   for (size_t i = 0; i < n; ++i) {
-    const double height = b.z[i] - at.ground_z;
-    const double dx = b.x[i] - at.x, dy = b.y[i] - at.y;
+    const double px = xyz[3 * i], py = xyz[3 * i + 1], pz = xyz[3 * i + 2];
+    const double height = pz - at.ground_z;
+    const double dx = px - at.x, dy = py - at.y;
     const double range2 = dx * dx + dy * dy;
     // NaN fails every comparison, so non-finite points do not count.
     b.counts[i] = (height >= at.band_min) & (height <= at.band_max) & (range2 <= at.max_range2) &
@@ -77,9 +78,15 @@ SONOMAP_VECTOR_LOOP void locate(size_t n, const Rasteriser::Placement& placement
   }
 }
 
-void locate_baseline(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
-SONOMAP_AVX2_KERNEL void locate_avx2(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
-SONOMAP_AVX512_KERNEL void locate_avx512(size_t n, const Rasteriser::Placement& at, Batch& b) { locate(n, at, b); }
+void locate_baseline(size_t n, const float* xyz, const Rasteriser::Placement& at, Batch& b) {
+  locate(n, xyz, at, b);
+}
+SONOMAP_AVX2_KERNEL void locate_avx2(size_t n, const float* xyz, const Rasteriser::Placement& at, Batch& b) {
+  locate(n, xyz, at, b);
+}
+SONOMAP_AVX512_KERNEL void locate_avx512(size_t n, const float* xyz, const Rasteriser::Placement& at, Batch& b) {
+  locate(n, xyz, at, b);
+}
 
 }  // namespace
 
@@ -129,16 +136,12 @@ inline int Rasteriser::last_row_fix(int row, const Eigen::Vector3f& point) const
 }
 
 void Rasteriser::add_to(Cells& cells, const Eigen::Vector3f* points, size_t count) const {
+  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float), "points are packed (x, y, z) floats");
   const auto locate_batch = kernel_for(vector_isa(), &locate_baseline, &locate_avx2, &locate_avx512);
   Batch b;
   for (size_t begin = 0; begin < count; begin += kBatch) {
     const size_t n = std::min(kBatch, count - begin);
-    for (size_t k = 0; k < n; ++k) {
-      b.x[k] = points[begin + k].x();
-      b.y[k] = points[begin + k].y();
-      b.z[k] = points[begin + k].z();
-    }
-    locate_batch(n, at_, b);
+    locate_batch(n, reinterpret_cast<const float*>(points + begin), at_, b);
     for (size_t k = 0; k < n; ++k) {
       if (!b.counts[k]) continue;
       const Eigen::Vector3f& point = points[begin + k];
