@@ -23,10 +23,11 @@ constexpr double kEdgeSnapDeg = 1e-9;    // degrees: rounding noise of atan2 at 
 // The first pass over a batch of points finds, for each, whether it counts, its range (the
 // square roots are cheaper eight at a time than one by one in the second pass), its bin
 // position by a fast arctangent and its row quotient. It is written without branches, over
-// plain arrays, reading the points' (x, y, z) floats where they lie (a copy of them into the
-// batch cost as many instructions as the pass itself), so that the compiler vectorises it (core/vector_isa.hpp: a copy
-// per instruction set; the top-level CMakeLists.txt gives the options it needs and why). The second
-// pass, one point at a time, places the points in their cells.
+// plain arrays, so that the compiler vectorises it (core/vector_isa.hpp: a copy per
+// instruction set; the top-level CMakeLists.txt gives the options it needs and why), and reads
+// the points' (x, y, z) floats where they lie (copying them into the batch first cost as many
+// instructions as the pass). The second pass, one point at a time, places the points in their
+// cells.
 constexpr size_t kBatch = 256;
 
 struct Batch {

@@ -441,7 +441,9 @@ class DepthView {
   // The silhouette tiles among tiles [tx0, tx1] x [ty0, ty1].
   int32_t silhouette_tiles_in(int tx0, int tx1, int ty0, int ty1) const {
     const size_t stride = static_cast<size_t>(tiles_across_) + 1;
-    auto before = [&](int tx, int ty) { return tiles_before_[static_cast<size_t>(ty) * stride + static_cast<size_t>(tx)]; };
+    auto before = [&](int tx, int ty) {
+      return tiles_before_[static_cast<size_t>(ty) * stride + static_cast<size_t>(tx)];
+    };
     return before(tx1 + 1, ty1 + 1) - before(tx0, ty1 + 1) - before(tx1 + 1, ty0) + before(tx0, ty0);
   }
   // One row of tiles: every second pixel of every second row against the next such pixel right
