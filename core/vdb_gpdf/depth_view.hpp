@@ -346,16 +346,14 @@ class DepthView {
   // camera, answers true. One test per local leaf instead of a projection per local voxel.
   bool may_touch_silhouette(const Eigen::AlignedBox3d& world) const {
     if (!image_) return true;
-    const PinholeIntrinsics& k = frame_.intrinsics;
     double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
     for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d c = camera_T_world_ * world.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner));
-      if (!(c.z() > 0.0)) return true;
-      const double u = k.fx * c.x() / c.z() + k.cx, v = k.fy * c.y() / c.z() + k.cy;
-      u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-      v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+      const std::optional<Eigen::Vector2d> p = projection(
+          frame_.intrinsics, camera_T_world_ * world.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
+      if (!p || !p->allFinite()) return true;
+      u_min = std::min(u_min, p->x()), u_max = std::max(u_max, p->x());
+      v_min = std::min(v_min, p->y()), v_max = std::max(v_max, p->y());
     }
-    if (!(std::isfinite(u_min) && std::isfinite(u_max) && std::isfinite(v_min) && std::isfinite(v_max))) return true;
     const double last_u = frame_.width - 1, last_v = frame_.height - 1;
     if (u_max + 1.0 < 0.0 || v_max + 1.0 < 0.0 || u_min - 1.0 > last_u || v_min - 1.0 > last_v) return false;
     auto tile = [](double pixel, double last) {

@@ -242,9 +242,9 @@ void ask_for_sums(const PointSumGrid::TreeType::LeafNodeType& leaf) {
 // The space a local leaf's centroids lie in: its cube, with a local voxel to spare on every side
 // (a centroid of float sums may round a hair past its voxel's face).
 Eigen::AlignedBox3d local_leaf_box(const openvdb::Coord& origin, double local_voxel) {
-  const Eigen::Vector3d low = Eigen::Vector3d(origin.x(), origin.y(), origin.z()) * local_voxel;
-  const Eigen::Vector3d spare = Eigen::Vector3d::Constant(local_voxel);
-  return {low - spare, low + Eigen::Vector3d::Constant(LeafCells::Leaf::DIM * local_voxel) + spare};
+  const Eigen::Vector3d centre = leaf_centre(origin, local_voxel);
+  const Eigen::Vector3d half = Eigen::Vector3d::Constant((kLeafDim / 2.0 + 1.0) * local_voxel);
+  return {centre - half, centre + half};
 }
 
 // The local leaves indexed for the GPs. Per local leaf, in parallel: its GP training points (the
