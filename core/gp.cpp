@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -158,6 +159,24 @@ SONOMAP_AVX512_KERNEL void sum_kernel_terms_avx512(const KernelInput& in, float*
                                                    KernelSums& out) {
   sum_kernel_terms<16, kGradient>(in, expo, radius, out);
 }
+
+// The kernel matrix K0 + noise I of the points at kernel rate a (only its lower triangle is
+// read by the Cholesky factorisation; both are filled).
+void fill_kernel_matrix(const std::vector<Eigen::Vector3f>& points, const GpParams& params, double a,
+                        Eigen::Ref<Eigen::MatrixXd> k) {
+  const int n = static_cast<int>(points.size());
+  for (int i = 0; i < n; ++i) {
+    k(i, i) = 1.0 + params.noise;
+    for (int j = 0; j < i; ++j) {
+      const double r2 = (points[i] - points[j]).cast<double>().squaredNorm();
+      const double v = params.kernel == GpKernel::RevertingSE
+                           ? std::exp(-0.5 * a * r2)
+                           : (1.0 + a * std::sqrt(r2)) * std::exp(-a * std::sqrt(r2));
+      k(i, j) = v;
+      k(j, i) = v;
+    }
+  }
+}
 }  // namespace
 
 void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& params) {
@@ -166,55 +185,55 @@ void SurfaceGp::train(std::vector<Eigen::Vector3f> points, const GpParams& param
   params_ = params;
   a_ = kernel_rate(params);
   points_ = std::move(points);
-  const int n = static_cast<int>(points_.size());
-  anchor_ = points_[0].cast<double>();
+  const size_t n = points_.size();
   // Padded to whole vectors with points 1 km away and no weight: their terms are zero.
-  const size_t padded = (points_.size() + kWidest - 1) / kWidest * kWidest;
-  xs_.assign(padded, 1000.0f);
-  ys_.assign(padded, 0.0f);
-  zs_.assign(padded, 0.0f);
-  for (int i = 0; i < n; ++i) {
+  padded_ = (n + kWidest - 1) / kWidest * kWidest;
+  store_.assign(4 * padded_ + n + row_start(n), 0.0f);
+  anchor_ = points_[0].cast<double>();
+  float* xs = store_.data();
+  std::fill(xs, xs + padded_, 1000.0f);
+  for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d d = points_[i].cast<double>() - anchor_;
-    xs_[i] = static_cast<float>(d.x());
-    ys_[i] = static_cast<float>(d.y());
-    zs_[i] = static_cast<float>(d.z());
+    xs[i] = static_cast<float>(d.x());
+    xs[padded_ + i] = static_cast<float>(d.y());
+    xs[2 * padded_ + i] = static_cast<float>(d.z());
   }
-  Eigen::MatrixXd k(n, n);
-  for (int i = 0; i < n; ++i) {
-    k(i, i) = 1.0 + params_.noise;
-    for (int j = 0; j < i; ++j) {
-      const double r2 = (points_[i] - points_[j]).cast<double>().squaredNorm();
-      const double v = params_.kernel == GpKernel::RevertingSE
-                           ? std::exp(-0.5 * a_ * r2)
-                           : (1.0 + a_ * std::sqrt(r2)) * std::exp(-a_ * std::sqrt(r2));
-      k(i, j) = v;
-      k(j, i) = v;
-    }
-  }
-  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(k);  // in place: no copy of K per GP
-  const Eigen::VectorXd alpha = llt.solve(Eigen::VectorXd::Ones(n));
-  alpha_lanes_.assign(padded, 0.0f);
-  for (int i = 0; i < n; ++i) alpha_lanes_[i] = static_cast<float>(alpha[i]);
+  // The kernel matrix and the weights in scratch kept by the thread (a frame trains hundreds of
+  // GPs): K alpha = 1, K factored in place.
+  thread_local std::vector<double> scratch;
+  scratch.resize(n * n + n);
+  const Eigen::Index size = static_cast<Eigen::Index>(n);
+  Eigen::Map<Eigen::MatrixXd> k(scratch.data(), size, size);
+  fill_kernel_matrix(points_, params_, a_, k);
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(k);
+  Eigen::Map<Eigen::VectorXd> alpha(scratch.data() + n * n, size);
+  alpha.setOnes();
+  llt.solveInPlace(alpha);
+  keep_solution(alpha, llt.matrixLLT());
+}
+
+void SurfaceGp::keep_solution(const Eigen::Ref<const Eigen::VectorXd>& alpha,
+                              const Eigen::Ref<const Eigen::MatrixXd>& factor) {
+  const size_t n = points_.size();
+  float* alpha_lanes = store_.data() + 3 * padded_;
+  for (size_t i = 0; i < n; ++i) alpha_lanes[i] = static_cast<float>(alpha[i]);
   // A mean of 0 or below has no log: predict() then takes the distance to the nearest point,
   // here the point itself.
-  point_distances_.resize(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
+  float* distances = store_.data() + 4 * padded_;
+  for (size_t i = 0; i < n; ++i) {
     const double f = 1.0 - params_.noise * alpha[i];
-    point_distances_[i] = f > 0.0 ? static_cast<float>(distance_of(std::log(f))) : 0.0f;
+    distances[i] = f > 0.0 ? static_cast<float>(distance_of(std::log(f))) : 0.0f;
   }
-  // The Cholesky factor is kept for the variance only, in float and packed: a quarter of the
-  // double matrix (a mapped room's global GPs held 23 MB of factors in double).
-  const auto& factor = llt.matrixLLT();  // L in its lower triangle (in k)
-  lower_.resize(static_cast<size_t>(n) * (n + 1) / 2);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j <= i; ++j) lower_[row_start(i) + j] = static_cast<float>(factor(i, j));
+  // The Cholesky factor (L in the lower triangle of `factor`) is kept for the variance only, in
+  // float and packed: a quarter of the double matrix (a mapped room's global GPs held 23 MB of
+  // factors in double).
+  float* lower = distances + n;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = 0; j <= i; ++j) lower[row_start(i) + j] = static_cast<float>(factor(i, j));
 }
 
 size_t SurfaceGp::memory_bytes() const {
-  return points_.capacity() * sizeof(Eigen::Vector3f) +
-         (xs_.capacity() + ys_.capacity() + zs_.capacity() + alpha_lanes_.capacity() + lower_.capacity() +
-          point_distances_.capacity()) *
-             sizeof(float);
+  return points_.capacity() * sizeof(Eigen::Vector3f) + store_.capacity() * sizeof(float);
 }
 
 double SurfaceGp::distance_of(double log_f) const {
@@ -233,7 +252,7 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   const bool se = params_.kernel == GpKernel::RevertingSE;
   const Eigen::Vector3d rel = x - anchor_;
   if (!rel.allFinite()) return out;
-  const KernelInput in{xs_.data(), ys_.data(), zs_.data(), alpha_lanes_.data(), n,
+  const KernelInput in{lane(0), lane(1), lane(2), lane(3), n,
                        static_cast<float>(rel.x()), static_cast<float>(rel.y()), static_cast<float>(rel.z()),
                        static_cast<float>(a_), se};
   // Scratch on the stack for the usual sizes (a local GP has at most about 100 points).
@@ -241,10 +260,10 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
   float expo_stack[kOnStack], radius_stack[kOnStack];
   float* expo = expo_stack;
   float* radius = radius_stack;
-  if (xs_.size() > kOnStack) {
+  if (padded_ > kOnStack) {
     thread_local std::vector<float> expo_heap, radius_heap;  // (a guard per use: here only)
-    expo_heap.resize(xs_.size());
-    radius_heap.resize(xs_.size());
+    expo_heap.resize(padded_);
+    radius_heap.resize(padded_);
     expo = expo_heap.data();
     radius = radius_heap.data();
   }
@@ -286,7 +305,7 @@ GpPrediction SurfaceGp::predict_as(const Eigen::Vector3d& x, bool with_variance)
     // v = L^-1 k* by forward substitution, summed in double; var f = 1 - |v|^2.
     Eigen::VectorXd v(n);
     for (size_t i = 0; i < n; ++i) {
-      const float* row = &lower_[row_start(i)];
+      const float* row = lower() + row_start(i);
       double s = kstar[i];
       for (size_t j = 0; j < i; ++j) s -= static_cast<double>(row[j]) * v[j];
       v[i] = s / static_cast<double>(row[i]);

@@ -52,24 +52,33 @@ class SurfaceGp {
   // itself: K alpha = 1 with K = K0 + noise I, so the mean there, K0 alpha, is 1 - noise alpha_i.
   // One look-up in place of predict's sum over every point (VDB-GPDF asks it at each of a
   // frame's training points, about half of its GP queries). Precondition: i < size().
-  double distance_at_point(size_t i) const { return point_distances_[i]; }
+  double distance_at_point(size_t i) const { return point_distances()[i]; }
 
  private:
   GpParams params_;
   double a_ = 0.0;  // kernel rate (see GpKernel)
   std::vector<Eigen::Vector3f> points_;
-  // The points again, relative to the first one, one array per axis: prediction runs over them
-  // in float SIMD lanes (a frame asks the local GPs about 30 thousand times at 5 cm).
+  // What prediction reads, in one allocation (a frame trains hundreds of GPs, and each array
+  // of its own was an allocation more per GP):
+  //  - the points again, relative to the first one, one array per axis, and their weights
+  //    alpha, each padded_ long: prediction runs over them in float SIMD lanes (a frame asks
+  //    the local GPs about 30 thousand times at 5 cm);
+  //  - distance_at_point's distances (size() of them);
+  //  - the Cholesky factor L of the kernel matrix (K = L L^T), row i's i + 1 entries from
+  //    row_start(i): what the variance needs.
   Eigen::Vector3d anchor_ = Eigen::Vector3d::Zero();
-  std::vector<float> xs_, ys_, zs_, alpha_lanes_;
-  std::vector<float> point_distances_;  // distance_at_point's
+  size_t padded_ = 0;
+  std::vector<float> store_;
+  const float* lane(size_t k) const { return store_.data() + k * padded_; }  // x, y, z, alpha
+  const float* point_distances() const { return lane(4); }
+  const float* lower() const { return point_distances() + points_.size(); }
+  // Keeps what prediction needs of the solve: the weights alpha, each point's distance and
+  // the Cholesky factor L (the lower triangle of `factor`).
+  void keep_solution(const Eigen::Ref<const Eigen::VectorXd>& alpha, const Eigen::Ref<const Eigen::MatrixXd>& factor);
   template <bool kGradient>
   GpPrediction predict_as(const Eigen::Vector3d& x, bool with_variance) const;
   // The distance of a mean f = exp(log_f) (log-GPIS: f = exp(-a d) or exp(-a d^2 / 2)).
   double distance_of(double log_f) const;
-  // The Cholesky factor L of the kernel matrix (K = L L^T), row i's i + 1 entries from
-  // row_start(i): what the variance needs.
-  std::vector<float> lower_;
   static size_t row_start(size_t i) { return i * (i + 1) / 2; }
 };
 

@@ -269,14 +269,17 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
   parallel_for_each_index(n, [&](size_t i) {
     const size_t on = leaves[i]->onVoxelCount();
     const int stride = cloud && on < kSparseLeafCells ? 1 : config.voxel_downsample;
+    const bool near_silhouette = view.may_touch_silhouette(local_leaf_box(leaves[i]->origin(), config.local_voxel));
+    // Room for every training point up front (edge voxels only near a silhouette): each vector
+    // grown one by one was hundreds of allocations a frame.
+    const size_t most_trained = near_silhouette ? on : on / stride + 1;
     cells[i].cells.reserve(on);
-    cells[i].trained.reserve(on / stride + 1);
-    out.training[i].reserve(on / stride + 1);
+    cells[i].trained.reserve(most_trained);
+    out.training[i].reserve(most_trained);
     cells[i].cell_of.fill(-1);
     ask_for_sums(*leaves[i]);
     std::optional<LocalVoxelsAround> around;
-    std::vector<Eigen::Vector3f> at_edges;
-    const bool near_silhouette = view.may_touch_silhouette(local_leaf_box(leaves[i]->origin(), config.local_voxel));
+    LeafCells::Leaf::NodeMaskType at_edges;  // the cells on an edge, trained after the others
     int k = 0;
     for (auto v = leaves[i]->cbeginValueOn(); v; ++v, ++k) {
       const Eigen::Vector3d c = centroid(*v);
@@ -287,11 +290,12 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
         out.training[i].push_back(c.cast<float>());
         cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
       } else if (near_silhouette && at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config)) {
-        at_edges.push_back(c.cast<float>());
-        cells[i].trained.emplace_back(voxel_of(at_edges.back().cast<double>(), config.global_voxel));
+        at_edges.setOn(static_cast<openvdb::Index>(k));
+        cells[i].trained.emplace_back(voxel_of(c.cast<float>().cast<double>(), config.global_voxel));
       }
     }
-    out.training[i].insert(out.training[i].end(), at_edges.begin(), at_edges.end());
+    for (auto e = at_edges.beginOn(); e; ++e)
+      out.training[i].push_back(cells[i].cells[e.pos()].centroid.cast<float>());
     for (const Eigen::Vector3f& t : out.training[i]) gps.bounds[i].extend(t.cast<double>());
     gps.origins[i] = leaves[i]->origin();
     gps.centres[i] = leaf_centre(gps.origins[i], config.local_voxel);
@@ -328,30 +332,34 @@ void near_surface(const std::vector<LeafCells>& leaves, openvdb::MaskGrid& mask)
                                      openvdb::tools::IGNORE_TILES, false);
 }
 
-// The sources: per local leaf its training points, then the first centroid (in leaf order)
-// of every global voxel without a training point that holds kMinSparseCells local voxels or
-// more, or lies at the image's edge. Candidates are found per leaf in parallel, then taken in
-// leaf order (marking their global voxel -1 in `counts`).
+// The sources besides the training points: the first centroid (in leaf order) of every global
+// voxel without a training point that holds kMinSparseCells local voxels or more, or lies at
+// the image's edge. Candidates are found per leaf in parallel, then taken in leaf order
+// (marking their global voxel -1 in `counts`).
 void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& leaves,
                         openvdb::Int32Grid& counts, LocalFrame& local) {
-  std::vector<std::vector<const LeafCells::Cell*>> candidates(leaves.size());
-  local.sources.resize(leaves.size());
+  std::vector<LeafCells::Leaf::NodeMaskType> candidates(leaves.size());  // per leaf, by cell index
   parallel_for_each_index(leaves.size(), [&](size_t i) {
-    local.sources[i] = local.training[i];
     const auto count = read_accessor(counts);
-    for (const auto& cell : leaves[i].cells) {
-      const int held = count.getValue(cell.global);
-      if (held >= kMinSparseCells || (held >= 1 && view.at_edge(cell.centroid, kEdgePixels)))
-        candidates[i].push_back(&cell);
+    const std::vector<LeafCells::Cell>& cells = leaves[i].cells;
+    for (size_t k = 0; k < cells.size(); ++k) {
+      const int held = count.getValue(cells[k].global);
+      if (held >= kMinSparseCells || (held >= 1 && view.at_edge(cells[k].centroid, kEdgePixels)))
+        candidates[i].setOn(static_cast<openvdb::Index>(k));
     }
   });
+  local.sparse_sources.resize(leaves.size());
   auto count = counts.getAccessor();
-  for (size_t i = 0; i < leaves.size(); ++i)
-    for (const LeafCells::Cell* cell : candidates[i]) {
-      if (count.getValue(cell->global) < 1) continue;  // taken by an earlier candidate
-      count.setValue(cell->global, -1);
-      local.sources[i].push_back(cell->centroid.cast<float>());
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    if (candidates[i].isOff()) continue;
+    local.sparse_sources[i].reserve(candidates[i].countOn());  // the most it takes
+    for (auto k = candidates[i].beginOn(); k; ++k) {
+      const LeafCells::Cell& cell = leaves[i].cells[k.pos()];
+      if (count.getValue(cell.global) < 1) continue;  // taken by an earlier candidate
+      count.setValue(cell.global, -1);
+      local.sparse_sources[i].push_back(cell.centroid.cast<float>());
     }
+  }
 }
 
 }  // namespace
@@ -368,7 +376,7 @@ void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& 
 void train_local_gps(const GpParams& params, LocalFrame& local) {
   local.gps.gps.resize(local.training.size());
   parallel_for_each_index(local.training.size(),
-                          [&](size_t i) { local.gps.gps[i].train(local.training[i], params); });
+                          [&](size_t i) { local.gps.gps[i].train(std::move(local.training[i]), params); });
 }
 
 }  // namespace sonomap::gpdf

@@ -31,15 +31,25 @@ struct LocalGps {
   // because an accessor finds the 26 neighbours of a leaf mostly in the node it has cached.
   openvdb::Int32Tree index{-1};
   using IndexAccessor = ReadAccessor<openvdb::Int32Tree>;  // per call
-  std::vector<std::vector<int>> neighbours;  // per leaf, its neighbouring leaves (of 26)
+  // Up to 26 leaves, held in place (a vector per leaf, grown one by one, was about 2,000
+  // allocations a frame).
+  struct LeafList {
+    std::array<int, 26> leaves;
+    int count = 0;
+    void add(int leaf) { leaves[static_cast<size_t>(count++)] = leaf; }
+    const int* begin() const { return leaves.data(); }
+    const int* end() const { return leaves.data() + count; }
+  };
+  std::vector<LeafList> neighbours;  // per leaf, its neighbouring leaves
 
   // Once every leaf is indexed: most queries lie in a leaf, and then smallest() reads its
   // neighbours from here instead of 26 lookups.
   void link_neighbours() {
-    neighbours.assign(origins.size(), {});
+    neighbours.resize(origins.size());
     parallel_for_each_index(origins.size(), [&](size_t i) {
       IndexAccessor at(index);
-      for_each_neighbour(at, origins[i], [&](int j) { neighbours[i].push_back(j); });
+      neighbours[i].count = 0;
+      for_each_neighbour(at, origins[i], [&](int j) { neighbours[i].add(j); });
     });
   }
 
@@ -70,7 +80,7 @@ struct LocalGps {
   struct Around {
     const int* begin = nullptr;
     const int* end = nullptr;
-    std::array<int, 26> found{};
+    LeafList found;
   };
 
   // One task's reads of the index, kept from query to query: its accessor has the node of the
@@ -114,15 +124,13 @@ struct LocalGps {
     Around& around = lookup.around;
     lookup.home = home;
     lookup.own = lookup.at.getValue(leaf_key_of(home));
-    if (lookup.own >= 0) {
-      around.begin = neighbours[lookup.own].data();
-      around.end = around.begin + neighbours[lookup.own].size();
-      return;
+    const LeafList& leaves = lookup.own >= 0 ? neighbours[lookup.own] : around.found;
+    if (lookup.own < 0) {
+      around.found.count = 0;
+      for_each_neighbour(lookup.at, home, [&](int j) { around.found.add(j); });
     }
-    int* next = around.found.data();
-    for_each_neighbour(lookup.at, home, [&](int j) { *next++ = j; });
-    around.begin = around.found.data();
-    around.end = next;
+    around.begin = leaves.begin();
+    around.end = leaves.end();
   }
 
   // The smallest distance the local GPs predict at q. Each GP knows only its own patch, so its
@@ -172,16 +180,16 @@ struct LocalFrame {
   PointSumGrid points{openvdb::Vec4f(0.0f)};
   LocalGps gps;
   std::vector<LeafCells> cells;
-  std::vector<std::vector<Eigen::Vector3f>> training;
-  // Per local leaf the points queries are placed around: its training points, and one
-  // centroid in every global voxel holding frame points in kMinSparseCells local voxels or
-  // more but no training point (a far surface, a pixel per local voxel, would otherwise be
-  // fused in patches).
-  std::vector<std::vector<Eigen::Vector3f>> sources;
+  std::vector<std::vector<Eigen::Vector3f>> training;  // per local leaf; moved into its GP (train_local_gps)
+  // Per local leaf the points queries are placed around besides its training points (the
+  // sources): one centroid in every global voxel holding frame points in kMinSparseCells
+  // local voxels or more but no training point (a far surface, a pixel per local voxel, would
+  // otherwise be fused in patches).
+  std::vector<std::vector<Eigen::Vector3f>> sparse_sources;
   openvdb::MaskGrid near{false};
 };
 
-// Stage "voxelise": the frame's points into `out` (points, cells, training points, sources,
+// Stage "voxelise": the frame's points into `out` (points, cells, training points, sparse sources,
 // the global voxels near the surface).
 void voxelise(const VdbGpdfConfig& config, const Frame& frame, const DepthView& view, LocalFrame& out);
 

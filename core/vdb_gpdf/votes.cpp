@@ -331,15 +331,16 @@ void mark_lone_inside_beside_rays(const VoteGrid& counts, const DistanceWeightGr
 
 void cast_votes(const VdbGpdfConfig& config, const LocalFrame& local, const DepthView& view,
                 const DistanceWeightGrid& fused, const Eigen::Vector3d& origin, FrameVotes& out) {
-  const size_t leaves = local.sources.size();
+  const size_t leaves = local.gps.gps.size();
   std::vector<std::vector<Vote>> votes(leaves);
   parallel_for_each_index(leaves, [&](size_t leaf) {
     LeafQueries queries(config, local, fused, leaf, origin, view);
-    queries.votes.reserve(local.sources[leaf].size() * kVotesPerSource);
-    const std::vector<Eigen::Vector3f>& sources = local.sources[leaf];
-    const size_t trained = local.training[leaf].size();  // the first sources (add_sparse_sources)
-    for (size_t i = 0; i < sources.size(); ++i)
-      queries.add(sources[i].cast<double>(), i < trained ? std::optional<size_t>(i) : std::nullopt);
+    // The sources: the leaf's training points, then its sparse sources.
+    const std::vector<Eigen::Vector3f>& trained = local.gps.gps[leaf].points();
+    const std::vector<Eigen::Vector3f>& sparse = local.sparse_sources[leaf];
+    queries.votes.reserve((trained.size() + sparse.size()) * kVotesPerSource);
+    for (size_t i = 0; i < trained.size(); ++i) queries.add(trained[i].cast<double>(), i);
+    for (const Eigen::Vector3f& p : sparse) queries.add(p.cast<double>(), std::nullopt);
     votes[leaf] = std::move(queries.votes);
   });
   openvdb::MaskGrid beside_rays(false);
