@@ -286,13 +286,14 @@ void index_local_leaves(const VdbGpdfConfig& config, const DepthView& view, cons
       cells[i].cell_of[v.pos()] = static_cast<int16_t>(cells[i].cells.size());
       cells[i].cells.push_back({c, voxel_of(c, config.global_voxel)});
       if (cloud) cells[i].box.extend(c);  // for WideNeighbourhood, clouds only
-      if (k % stride == 0) {
-        out.training[i].push_back(c.cast<float>());
-        cells[i].trained.emplace_back(voxel_of(out.training[i].back().cast<double>(), config.global_voxel));
-      } else if (near_silhouette && at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config)) {
-        at_edges.setOn(static_cast<openvdb::Index>(k));
-        cells[i].trained.emplace_back(voxel_of(c.cast<float>().cast<double>(), config.global_voxel));
-      }
+      const bool strided = k % stride == 0;
+      const bool on_edge = !strided && near_silhouette &&
+                           at_seen_edge(around, out.points, *leaves[i], view, v.getCoord(), c, eye, config);
+      if (!strided && !on_edge) continue;
+      const Eigen::Vector3f point = c.cast<float>();  // as the GP holds it
+      cells[i].trained.emplace_back(voxel_of(point.cast<double>(), config.global_voxel));
+      if (strided) out.training[i].push_back(point);
+      if (on_edge) at_edges.setOn(static_cast<openvdb::Index>(k));
     }
     for (auto e = at_edges.beginOn(); e; ++e)
       out.training[i].push_back(cells[i].cells[e.pos()].centroid.cast<float>());
@@ -351,8 +352,7 @@ void add_sparse_sources(const DepthView& view, const std::vector<LeafCells>& lea
   local.sparse_sources.resize(leaves.size());
   auto count = counts.getAccessor();
   for (size_t i = 0; i < leaves.size(); ++i) {
-    if (candidates[i].isOff()) continue;
-    local.sparse_sources[i].reserve(candidates[i].countOn());  // the most it takes
+    local.sparse_sources[i].reserve(candidates[i].countOn());  // the most it takes (none: no allocation)
     for (auto k = candidates[i].beginOn(); k; ++k) {
       const LeafCells::Cell& cell = leaves[i].cells[k.pos()];
       if (count.getValue(cell.global) < 1) continue;  // taken by an earlier candidate

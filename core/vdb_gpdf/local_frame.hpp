@@ -124,11 +124,11 @@ struct LocalGps {
     Around& around = lookup.around;
     lookup.home = home;
     lookup.own = lookup.at.getValue(leaf_key_of(home));
-    const LeafList& leaves = lookup.own >= 0 ? neighbours[lookup.own] : around.found;
     if (lookup.own < 0) {
       around.found.count = 0;
       for_each_neighbour(lookup.at, home, [&](int j) { around.found.add(j); });
     }
+    const LeafList& leaves = lookup.own >= 0 ? neighbours[lookup.own] : around.found;
     around.begin = leaves.begin();
     around.end = leaves.end();
   }
