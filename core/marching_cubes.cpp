@@ -95,24 +95,52 @@ const std::array<TriangleList, 256>& triangle_table() {
 constexpr int kSpan = kLeafDim + 1;  // a leaf's cubes read one voxel beyond it
 inline int local_index(int x, int y, int z) { return (x * kSpan + y) * kSpan + z; }
 
+// The values a leaf's cubes read: its own voxels and the first plane of its upper neighbours.
+struct LeafSpan {
+  std::array<float, kSpan * kSpan * kSpan> dist, weight;
+  bool any_inside = false, any_outside = false;  // among the voxels of weight >= min_weight
+};
+
+// Reads the span of the leaf at `origin` from that leaf and its 7 upper neighbours, each found
+// once: a look-up per voxel through an accessor (729 of them) cost most of the marching. A
+// neighbour that is not a leaf holds one value (a tile's, or the background) throughout.
+void read_span(const DistanceWeightGrid& grid, const openvdb::Coord& origin, float min_weight,
+               LeafSpan& span) {
+  using Leaf = DistanceWeightGrid::TreeType::LeafNodeType;
+  const auto acc = read_accessor(grid);
+  for (int part = 0; part < 8; ++part) {
+    const int upper[3] = {(part >> 2) & 1, (part >> 1) & 1, part & 1};
+    const openvdb::Coord part_origin =
+        origin.offsetBy(upper[0] * kLeafDim, upper[1] * kLeafDim, upper[2] * kLeafDim);
+    const Leaf* leaf = acc.probeConstLeaf(part_origin);
+    const auto tile = leaf ? openvdb::Vec2s() : acc.getValue(part_origin);
+    int lo[3], hi[3];  // this part's box in the span
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = upper[a] ? kLeafDim : 0;
+      hi[a] = upper[a] ? kSpan : kLeafDim;
+    }
+    for (int x = lo[0]; x < hi[0]; ++x)
+      for (int y = lo[1]; y < hi[1]; ++y)
+        for (int z = lo[2]; z < hi[2]; ++z) {
+          const auto& v = leaf ? leaf->getValue(Leaf::coordToOffset(openvdb::Coord(x, y, z))) : tile;
+          const int i = local_index(x, y, z);
+          span.dist[i] = v[0];
+          span.weight[i] = v[1];
+          if (v[1] >= min_weight) (v[0] >= 0.0f ? span.any_inside : span.any_outside) = true;
+        }
+  }
+}
+
 }  // namespace
 
 void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, double voxel_size,
                 float min_weight, SurfaceMesh& out) {
   const auto& table = triangle_table();
-  std::array<float, kSpan * kSpan * kSpan> dist, weight;
-  const auto acc = read_accessor(grid);
-  bool any_inside = false, any_outside = false;
-  for (int x = 0; x < kSpan; ++x)
-    for (int y = 0; y < kSpan; ++y)
-      for (int z = 0; z < kSpan; ++z) {
-        const auto v = acc.getValue(origin.offsetBy(x, y, z));
-        const int i = local_index(x, y, z);
-        dist[i] = v[0];
-        weight[i] = v[1];
-        if (v[1] >= min_weight) (v[0] >= 0.0f ? any_inside : any_outside) = true;
-      }
-  if (!any_inside || !any_outside) return;
+  LeafSpan span;
+  read_span(grid, origin, min_weight, span);
+  if (!span.any_inside || !span.any_outside) return;
+  const auto& dist = span.dist;
+  const auto& weight = span.weight;
 
   std::array<int, kSpan * kSpan * kSpan * 3> vertex_of_edge;
   vertex_of_edge.fill(-1);
@@ -245,18 +273,33 @@ void sample_surface(const SurfaceMesh& mesh, double spacing, std::vector<Eigen::
   }
 }
 
+namespace {
+
+// Bit s (1 to 7) set when a voxel of `voxels` lies on the leaf's lower faces along each axis of
+// subset s (1 x, 2 y, 4 z): the cubes of the neighbour one leaf lower along those axes reach
+// it. Read word by word: voxel x << 6 | y << 3 | z is bit y << 3 | z of word x, so the face
+// x = 0 is word 0, y = 0 the low byte of every word and z = 0 the low bit of every byte.
+unsigned lower_neighbours_reached(const LeafMask& voxels) {
+  static_assert(kLeafLog2 == 3 && LeafMask::WORD_COUNT == 8, "a word per plane of constant x");
+  constexpr uint64_t kY0 = 0xFF, kZ0 = 0x0101010101010101ull;
+  uint64_t any_x = 0;
+  for (openvdb::Index w = 0; w < LeafMask::WORD_COUNT; ++w) any_x |= voxels.getWord<uint64_t>(w);
+  const uint64_t x0 = voxels.getWord<uint64_t>(0);
+  const uint64_t on_faces[8] = {0, x0, any_x & kY0, x0 & kY0, any_x & kZ0, x0 & kZ0, any_x & 1, x0 & 1};
+  unsigned subsets = 0;
+  for (unsigned s = 1; s < 8; ++s)
+    if (on_faces[s] != 0) subsets |= 1u << s;
+  return subsets;
+}
+
+}  // namespace
+
 std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed) {
   std::vector<openvdb::Coord> out;
   for (const LeafChanges& leaf : changed) {
     if (leaf.voxels.isOff()) continue;
     out.push_back(leaf.origin);
-    unsigned subsets = 0;  // bit s set: the lower neighbour along axis subset s is affected
-    for (auto v = leaf.voxels.beginOn(); v; ++v) {
-      const openvdb::Index i = v.pos();  // x << 6 | y << 3 | z
-      const unsigned m = ((i >> 6) == 0) | (((i >> 3) & 7) == 0) << 1 | ((i & 7) == 0) << 2;
-      for (unsigned s = 1; s < 8; ++s)
-        if ((s & m) == s) subsets |= 1u << s;
-    }
+    const unsigned subsets = lower_neighbours_reached(leaf.voxels);
     for (unsigned s = 1; s < 8; ++s)
       if (subsets & (1u << s))
         out.push_back(leaf.origin.offsetBy((s & 1) ? -kLeafDim : 0, (s & 2) ? -kLeafDim : 0,
@@ -265,13 +308,6 @@ std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
-}
-
-std::vector<LeafChanges> leaf_changes(const openvdb::MaskGrid& touched) {
-  std::vector<LeafChanges> changed;
-  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf)
-    changed.push_back({leaf->origin(), leaf->getValueMask()});
-  return changed;
 }
 
 void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vector3f> samples) {

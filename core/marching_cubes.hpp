@@ -109,8 +109,15 @@ struct LeafChanges {
 // for voxels on a leaf's lower faces, the lower neighbours whose cubes reach into it.
 // Returned sorted (deterministic).
 std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed);
-// The active voxels of `touched`, leaf by leaf.
-std::vector<LeafChanges> leaf_changes(const openvdb::MaskGrid& touched);
+// The active voxels of `touched` (a grid of the same leaf size, any value type), leaf by leaf,
+// in the tree's order.
+template <class GridT>
+std::vector<LeafChanges> leaf_changes(const GridT& touched) {
+  std::vector<LeafChanges> changed;
+  for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf)
+    changed.push_back({leaf->origin(), leaf->getValueMask()});
+  return changed;
+}
 
 // Dense surface samples per leaf of a grid, refreshed leaf by leaf, queried by a horizontal
 // disc so the cost follows the queried area, not the whole map.

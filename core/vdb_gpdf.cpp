@@ -160,12 +160,11 @@ void VdbGpdf::integrate(const Frame& frame) {
 }
 
 void VdbGpdf::update_global_field(const DistanceWeightGrid& frame_sums) {
-  openvdb::MaskGrid touched(false);
-  touched.topologyUnion(frame_sums);
+  // The frame's sums are active exactly at the voxels the frame touched.
+  const std::vector<LeafChanges> changed = leaf_changes(frame_sums);
   std::unordered_map<openvdb::Coord, int, CoordHash> touched_count;
-  for (auto leaf = frame_sums.tree().cbeginLeaf(); leaf; ++leaf)
-    touched_count[leaf->origin()] = static_cast<int>(leaf->onVoxelCount());
-  const std::vector<openvdb::Coord> dirty = dirty_leaves(leaf_changes(touched));
+  for (const LeafChanges& leaf : changed) touched_count[leaf.origin] = static_cast<int>(leaf.voxels.countOn());
+  const std::vector<openvdb::Coord> dirty = dirty_leaves(changed);
 
   std::vector<SurfaceMesh> meshes = fused_.refresh(dirty);
   for (size_t i = 0; i < dirty.size(); ++i) {
