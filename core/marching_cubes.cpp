@@ -95,10 +95,24 @@ const std::array<TriangleList, 256>& triangle_table() {
 constexpr int kSpan = kLeafDim + 1;  // a leaf's cubes read one voxel beyond it
 inline int local_index(int x, int y, int z) { return (x * kSpan + y) * kSpan + z; }
 
+// Corners 0-3 go round the square of a cube's lower face, corners 4-7 the same one voxel up.
+constexpr bool corners_are_two_squares() {
+  constexpr int kSquare[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (int c = 0; c < 8; ++c)
+    if (kCorner[c][0] != kSquare[c % 4][0] || kCorner[c][1] != kSquare[c % 4][1] || kCorner[c][2] != c / 4)
+      return false;
+  return true;
+}
+
 // The values a leaf's cubes read: its own voxels and the first plane of its upper neighbours.
+// Per column (x, y) of the span, bit z says whether voxel (x, y, z) is observed (weight >=
+// min_weight) and whether it is inside (distance >= 0): a cube's eight corners are then bits
+// of four columns, and a column's cubes that are observed and cut by the surface are found
+// for all eight heights at once.
 struct LeafSpan {
-  std::array<float, kSpan * kSpan * kSpan> dist, weight;
-  bool any_inside = false, any_outside = false;  // among the voxels of weight >= min_weight
+  std::array<float, kSpan * kSpan * kSpan> dist;
+  std::array<uint16_t, kSpan * kSpan> observed{}, inside{};
+  static int column(int x, int y) { return x * kSpan + y; }
 };
 
 // Reads the span of the leaf at `origin` from that leaf and its 7 upper neighbours, each found
@@ -113,6 +127,7 @@ void read_span(const DistanceWeightGrid& grid, const openvdb::Coord& origin, flo
     const openvdb::Coord part_origin =
         origin.offsetBy(upper[0] * kLeafDim, upper[1] * kLeafDim, upper[2] * kLeafDim);
     const Leaf* leaf = acc.probeConstLeaf(part_origin);
+    const openvdb::Vec2s* values = leaf ? leaf->buffer().data() : nullptr;  // loaded once, not per value
     const auto tile = leaf ? openvdb::Vec2s() : acc.getValue(part_origin);
     int lo[3], hi[3];  // this part's box in the span
     for (int a = 0; a < 3; ++a) {
@@ -120,15 +135,62 @@ void read_span(const DistanceWeightGrid& grid, const openvdb::Coord& origin, flo
       hi[a] = upper[a] ? kSpan : kLeafDim;
     }
     for (int x = lo[0]; x < hi[0]; ++x)
-      for (int y = lo[1]; y < hi[1]; ++y)
+      for (int y = lo[1]; y < hi[1]; ++y) {
+        unsigned observed = 0, inside = 0;
         for (int z = lo[2]; z < hi[2]; ++z) {
-          const auto& v = leaf ? leaf->getValue(Leaf::coordToOffset(openvdb::Coord(x, y, z))) : tile;
-          const int i = local_index(x, y, z);
-          span.dist[i] = v[0];
-          span.weight[i] = v[1];
-          if (v[1] >= min_weight) (v[0] >= 0.0f ? span.any_inside : span.any_outside) = true;
+          const auto& v = values ? values[Leaf::coordToOffset(openvdb::Coord(x, y, z))] : tile;
+          span.dist[local_index(x, y, z)] = v[0];
+          observed |= static_cast<unsigned>(v[1] >= min_weight) << z;
+          inside |= static_cast<unsigned>(v[0] >= 0.0f) << z;
         }
+        span.observed[LeafSpan::column(x, y)] |= static_cast<uint16_t>(observed);
+        span.inside[LeafSpan::column(x, y)] |= static_cast<uint16_t>(inside);
+      }
   }
+}
+
+// Whether the span holds both an observed voxel inside and one outside: else no cube is cut.
+bool has_both_sides(const LeafSpan& span) {
+  unsigned in = 0, out = 0;
+  for (size_t c = 0; c < span.observed.size(); ++c) {
+    in |= span.observed[c] & span.inside[c];
+    out |= span.observed[c] & ~span.inside[c];
+  }
+  return in != 0 && out != 0;
+}
+
+// The columns of the cubes above (x, y): those of corners 0-3, in order (corners 4-7 are the
+// same columns one bit up).
+struct CubeColumns {
+  int at[4];
+};
+CubeColumns cube_columns(int x, int y) {
+  static_assert(corners_are_two_squares(), "corners 0-3 go round the square at z, corners 4-7 the same at z + 1");
+  return {{LeafSpan::column(x, y), LeafSpan::column(x + 1, y), LeafSpan::column(x + 1, y + 1),
+           LeafSpan::column(x, y + 1)}};
+}
+
+// Bit z set: cube z of the columns has its eight corners observed, some of them inside and not
+// all (the others hold no surface).
+unsigned cut_cubes(const LeafSpan& span, const CubeColumns& columns) {
+  unsigned observed = ~0u, any_inside = 0, all_inside = ~0u;
+  for (const int c : columns.at) {
+    observed &= span.observed[c];
+    any_inside |= span.inside[c];
+    all_inside &= span.inside[c];
+  }
+  const unsigned cut = observed & (observed >> 1) & (any_inside | any_inside >> 1) & ~(all_inside & all_inside >> 1);
+  return cut & ((1u << kLeafDim) - 1);
+}
+
+// Cube z's configuration: bit c set when corner c is inside.
+int cube_config(const LeafSpan& span, const CubeColumns& columns, int z) {
+  int config = 0;
+  for (int c = 0; c < 4; ++c) {
+    const unsigned bits = span.inside[columns.at[c]] >> z;
+    config |= static_cast<int>(bits & 1u) << c | static_cast<int>((bits >> 1) & 1u) << (c + 4);
+  }
+  return config;
 }
 
 }  // namespace
@@ -138,9 +200,8 @@ void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, do
   const auto& table = triangle_table();
   LeafSpan span;
   read_span(grid, origin, min_weight, span);
-  if (!span.any_inside || !span.any_outside) return;
+  if (!has_both_sides(span)) return;
   const auto& dist = span.dist;
-  const auto& weight = span.weight;
 
   std::array<int, kSpan * kSpan * kSpan * 3> vertex_of_edge;
   vertex_of_edge.fill(-1);
@@ -158,16 +219,11 @@ void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, do
     return id;
   };
   for (int x = 0; x < kLeafDim; ++x)
-    for (int y = 0; y < kLeafDim; ++y)
-      for (int z = 0; z < kLeafDim; ++z) {
-        int config = 0;
-        bool valid = true;
-        for (int c = 0; c < 8 && valid; ++c) {
-          const int i = local_index(x + kCorner[c][0], y + kCorner[c][1], z + kCorner[c][2]);
-          valid = weight[i] >= min_weight;
-          if (dist[i] >= 0.0f) config |= 1 << c;
-        }
-        if (!valid || config == 0 || config == 255) continue;
+    for (int y = 0; y < kLeafDim; ++y) {
+      const CubeColumns columns = cube_columns(x, y);
+      for (unsigned cut = cut_cubes(span, columns); cut != 0; cut &= cut - 1) {
+        const int z = __builtin_ctz(cut);
+        const int config = cube_config(span, columns, z);
         for (const auto& tri : table[config]) {
           Eigen::Vector3i ids;
           for (int k = 0; k < 3; ++k) {
@@ -178,6 +234,7 @@ void march_leaf(const DistanceWeightGrid& grid, const openvdb::Coord& origin, do
           out.triangles.push_back(ids);
         }
       }
+    }
 }
 
 SurfaceMesh march_grid(const DistanceWeightGrid& grid, double voxel_size, float min_weight) {
