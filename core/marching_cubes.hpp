@@ -113,6 +113,7 @@ std::vector<openvdb::Coord> dirty_leaves(const std::vector<LeafChanges>& changed
 // in the tree's order.
 template <class GridT>
 std::vector<LeafChanges> leaf_changes(const GridT& touched) {
+  static_assert(GridT::TreeType::LeafNodeType::LOG2DIM == kLeafLog2, "a LeafMask per leaf");
   std::vector<LeafChanges> changed;
   for (auto leaf = touched.tree().cbeginLeaf(); leaf; ++leaf)
     changed.push_back({leaf->origin(), leaf->getValueMask()});
