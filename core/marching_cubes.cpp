@@ -93,7 +93,9 @@ const std::array<TriangleList, 256>& triangle_table() {
 }
 
 constexpr int kSpan = kLeafDim + 1;  // a leaf's cubes read one voxel beyond it
-inline int local_index(int x, int y, int z) { return (x * kSpan + y) * kSpan + z; }
+// A column (x, y) of the span, and a voxel (x, y, z) as the z-th of its column.
+inline int column_index(int x, int y) { return x * kSpan + y; }
+inline int local_index(int x, int y, int z) { return column_index(x, y) * kSpan + z; }
 
 // Corners 0-3 go round the square of a cube's lower face, corners 4-7 the same one voxel up.
 constexpr bool corners_are_two_squares() {
@@ -112,7 +114,6 @@ constexpr bool corners_are_two_squares() {
 struct LeafSpan {
   std::array<float, kSpan * kSpan * kSpan> dist;
   std::array<uint16_t, kSpan * kSpan> observed{}, inside{};
-  static int column(int x, int y) { return x * kSpan + y; }
 };
 
 // Reads the span of the leaf at `origin` from that leaf and its 7 upper neighbours, each found
@@ -143,8 +144,8 @@ void read_span(const DistanceWeightGrid& grid, const openvdb::Coord& origin, flo
           observed |= static_cast<unsigned>(v[1] >= min_weight) << z;
           inside |= static_cast<unsigned>(v[0] >= 0.0f) << z;
         }
-        span.observed[LeafSpan::column(x, y)] |= static_cast<uint16_t>(observed);
-        span.inside[LeafSpan::column(x, y)] |= static_cast<uint16_t>(inside);
+        span.observed[column_index(x, y)] |= static_cast<uint16_t>(observed);
+        span.inside[column_index(x, y)] |= static_cast<uint16_t>(inside);
       }
   }
 }
@@ -166,8 +167,8 @@ struct CubeColumns {
 };
 CubeColumns cube_columns(int x, int y) {
   static_assert(corners_are_two_squares(), "corners 0-3 go round the square at z, corners 4-7 the same at z + 1");
-  return {{LeafSpan::column(x, y), LeafSpan::column(x + 1, y), LeafSpan::column(x + 1, y + 1),
-           LeafSpan::column(x, y + 1)}};
+  return {{column_index(x, y), column_index(x + 1, y), column_index(x + 1, y + 1),
+           column_index(x, y + 1)}};
 }
 
 // Bit z set: cube z of the columns has its eight corners observed, some of them inside and not
