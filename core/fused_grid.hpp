@@ -43,6 +43,11 @@ class FusedGrid {
   // The same restricted to heights z in [z_min, z_max]: leaves outside them are not read.
   void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
                               double z_max, std::vector<Eigen::Vector3f>& out) const;
+  // The same leaves' samples in place, a span per leaf (Mapper::surface_spans_in_band).
+  void surface_spans_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                             double z_max, std::vector<SampleSpan>& spans) const {
+    cache_.spans(center, radius, z_min, z_max, spans);
+  }
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                     std::vector<Eigen::Vector3i>& triangles) const;
   size_t memory_bytes() const;
@@ -67,6 +72,11 @@ class FusedGridMapper : public Mapper {
   void surface_points_in_band(const Eigen::Vector3d& center, double radius, double z_min,
                               double z_max, std::vector<Eigen::Vector3f>& out) const override {
     fused_.surface_points_in_band(center, radius, z_min, z_max, out);
+  }
+  void surface_spans_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                             double z_max, std::vector<SampleSpan>& spans,
+                             std::vector<Eigen::Vector3f>& /*scratch*/) const override {
+    fused_.surface_spans_in_band(center, radius, z_min, z_max, spans);
   }
   void surface_mesh(std::vector<Eigen::Vector3f>& vertices,
                     std::vector<Eigen::Vector3i>& triangles) const override {

@@ -4,9 +4,10 @@
 //
 // How a run drives a mapper: a factory (harness/app/mapper_registry.hpp) builds one fresh
 // mapper per run; config_entries() is read once; then for every frame in order, integrate()
-// and last_stage_times(); on evaluated frames surface_points_in_band() around the listener (and,
-// when the EDF comparison is on, query()); surface_points() for a sweep's room; surface_mesh()
-// once at the end; memory_bytes() by `bench map`.
+// and last_stage_times(); on evaluated frames surface_spans_in_band() around the listener
+// (and surface_points_in_band() for a video's top view, query() when the EDF comparison is
+// on); surface_points() for a sweep's room; surface_mesh() once at the end; memory_bytes() by
+// `bench map`.
 // Thread-safety: the harness never calls one mapper from two threads at once, and const calls
 // never overlap integrate(). A mapper may use TBB inside its calls (`--threads` caps it), but
 // its results must not depend on the thread count or on timing: same frames, same output.
@@ -64,6 +65,18 @@ class Mapper {
   virtual void surface_points_in_band(const Eigen::Vector3d& center, double radius, double /*z_min*/,
                                       double /*z_max*/, std::vector<Eigen::Vector3f>& out) const {
     surface_points(center, radius, out);
+  }
+  // The same samples read in place, which is what the rasters call: `spans` is replaced by
+  // runs of samples that, one after the other, hold every sample of surface_points_in_band()
+  // in its order. Samples outside the band or the radius may lie between them (the rasteriser
+  // ignores those). The spans stay valid until the next non-const call. A map that keeps its
+  // samples by leaf hands over whole leaves without copying them; the default copies
+  // surface_points_in_band() into `scratch` and hands over that.
+  virtual void surface_spans_in_band(const Eigen::Vector3d& center, double radius, double z_min,
+                                     double z_max, std::vector<SampleSpan>& spans,
+                                     std::vector<Eigen::Vector3f>& scratch) const {
+    surface_points_in_band(center, radius, z_min, z_max, scratch);
+    spans.assign(1, SampleSpan{scratch.data(), scratch.size()});
   }
   // Distance field queries (batched, world points): `out` gets exactly one answer per point.
   // Maps without a field answer observed = false everywhere.

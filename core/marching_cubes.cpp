@@ -388,21 +388,35 @@ void SurfaceCache::set(const openvdb::Coord& leaf_origin, std::vector<Eigen::Vec
   leaf.points = std::move(samples);
 }
 
-void SurfaceCache::collect(const Eigen::Vector3d& center, double radius, double z_min,
-                           double z_max, std::vector<Eigen::Vector3f>& out) const {
+namespace {
+
+// Whether (x, y) lies within horizontal distance sqrt(r2) of the centre.
+inline bool within_disc(float x, float y, const Eigen::Vector3d& center, double r2) {
+  const double dx = x - center.x(), dy = y - center.y();
+  return dx * dx + dy * dy <= r2;
+}
+
+}  // namespace
+
+template <class Visit>
+void SurfaceCache::visit_leaves(const Eigen::Vector3d& center, double radius, double z_min,
+                                double z_max, Visit&& visit) const {
   if (leaves_.empty() || !(radius >= 0.0)) return;
   const int x0 = static_cast<int>(std::floor((center.x() - radius) / leaf_size_)) * kLeafDim;
   const int x1 = static_cast<int>(std::floor((center.x() + radius) / leaf_size_)) * kLeafDim;
   const int y0 = static_cast<int>(std::floor((center.y() - radius) / leaf_size_)) * kLeafDim;
   const int y1 = static_cast<int>(std::floor((center.y() + radius) / leaf_size_)) * kLeafDim;
+  // within_disc() rounds monotonically in each coordinate, so the corner of a leaf's bounds
+  // farthest from the centre bounds its samples' distances from above, and the point of the
+  // bounds nearest to it (floats all) from below.
   const double r2 = radius * radius;
-  auto within = [&](const Eigen::Vector2f& p) {
-    const double dx = p.x() - center.x(), dy = p.y() - center.y();
-    return dx * dx + dy * dy <= r2;
-  };
+  auto within = [&](float x, float y) { return within_disc(x, y, center, r2); };
   auto in_heights = [&](float z) { return z >= z_min && z <= z_max; };
   auto farther = [](float lo, float hi, double c) {
     return std::abs(lo - c) > std::abs(hi - c) ? lo : hi;
+  };
+  auto nearest = [](float lo, float hi, double c) {
+    return c < lo ? lo : (c > hi ? hi : static_cast<float>(c));
   };
   for (int x = x0; x <= x1; x += kLeafDim)
     for (int y = y0; y <= y1; y += kLeafDim)
@@ -411,18 +425,35 @@ void SurfaceCache::collect(const Eigen::Vector3d& center, double radius, double 
         if (it == leaves_.end()) continue;
         const LeafSamples& leaf = it->second;
         if (leaf.max.z() < z_min || leaf.min.z() > z_max) continue;
-        // within() rounds monotonically in each coordinate: when the farthest corner of the
-        // leaf's bounds is within, every sample is. Then, if all heights are in, copy them all.
-        const Eigen::Vector2f far_corner(farther(leaf.min.x(), leaf.max.x(), center.x()),
-                                         farther(leaf.min.y(), leaf.max.y(), center.y()));
-        const bool all_within = within(far_corner);
-        if (all_within && in_heights(leaf.min.z()) && in_heights(leaf.max.z())) {
-          out.insert(out.end(), leaf.points.begin(), leaf.points.end());
+        if (!within(nearest(leaf.min.x(), leaf.max.x(), center.x()),
+                    nearest(leaf.min.y(), leaf.max.y(), center.y())))
           continue;
-        }
-        for (const auto& p : leaf.points)
-          if ((all_within || within(p.head<2>())) && in_heights(p.z())) out.push_back(p);
+        const bool all_within = within(farther(leaf.min.x(), leaf.max.x(), center.x()),
+                                       farther(leaf.min.y(), leaf.max.y(), center.y()));
+        visit(leaf, all_within, all_within && in_heights(leaf.min.z()) && in_heights(leaf.max.z()));
       }
+}
+
+void SurfaceCache::collect(const Eigen::Vector3d& center, double radius, double z_min,
+                           double z_max, std::vector<Eigen::Vector3f>& out) const {
+  const double r2 = radius * radius;
+  visit_leaves(center, radius, z_min, z_max, [&](const LeafSamples& leaf, bool all_within, bool all_in) {
+    if (all_in) {
+      out.insert(out.end(), leaf.points.begin(), leaf.points.end());
+      return;
+    }
+    for (const auto& p : leaf.points)
+      if ((all_within || within_disc(p.x(), p.y(), center, r2)) && p.z() >= z_min && p.z() <= z_max)
+        out.push_back(p);
+  });
+}
+
+void SurfaceCache::spans(const Eigen::Vector3d& center, double radius, double z_min,
+                         double z_max, std::vector<SampleSpan>& out) const {
+  out.clear();
+  visit_leaves(center, radius, z_min, z_max, [&](const LeafSamples& leaf, bool, bool) {
+    out.push_back(SampleSpan{leaf.points.data(), leaf.points.size()});
+  });
 }
 
 size_t SurfaceCache::sample_count() const {

@@ -9,6 +9,8 @@
 // minimum weight; the surface is its zero crossing.
 #pragma once
 
+#include "core/types.hpp"
+
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
@@ -132,6 +134,10 @@ class SurfaceCache {
   // disc or the heights is skipped without reading them.
   void collect(const Eigen::Vector3d& center, double radius, double z_min, double z_max,
                std::vector<Eigen::Vector3f>& out) const;
+  // The same leaves, in the same order, handed over whole: every sample collect() appends is
+  // in `out`'s spans in its order, with the other samples of its leaf around it.
+  void spans(const Eigen::Vector3d& center, double radius, double z_min, double z_max,
+             std::vector<SampleSpan>& out) const;
   size_t leaf_count() const { return leaves_.size(); }
   size_t sample_count() const;
   void clear() { leaves_.clear(); }
@@ -141,6 +147,13 @@ class SurfaceCache {
     std::vector<Eigen::Vector3f> points;
     Eigen::Vector3f min, max;  // their bounds
   };
+  // Calls visit(leaf, all_within, all_in) for each leaf that may hold a sample within the disc
+  // and the heights, in a fixed order; all_within says that every sample of the leaf is within
+  // the disc, all_in that every sample is within the disc and the heights.
+  template <class Visit>
+  void visit_leaves(const Eigen::Vector3d& center, double radius, double z_min, double z_max,
+                    Visit&& visit) const;
+
   double leaf_size_;  // world size of one leaf (8 voxels)
   std::unordered_map<openvdb::Coord, LeafSamples, CoordHash> leaves_;
   int min_z_ = 0, max_z_ = -1;  // range of leaf origins' z (index space) seen so far

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -26,7 +27,15 @@ void RasterConfig::validate() const {
          std::to_string(band_max) + ")");
   }
   if (!std::isfinite(row_height) || !(row_height > 0.0)) fail("row_height must be > 0");
-  if (rows() < 1) fail("row_height is taller than the band: no cylinder row fits");
+  // As rows() counts them, in doubles: a tiny row height must not overflow the count.
+  const double row_count = std::floor((band_max - band_min) / row_height + 1e-9);
+  if (row_count < 1.0) fail("row_height is taller than the band: no cylinder row fits");
+  if (row_count * azimuth_bins > kMaxCylinderCells) {
+    std::ostringstream what;
+    what << "row_height " << row_height << " m with " << azimuth_bins << " azimuth_bins makes a cylinder of "
+         << row_count * azimuth_bins << " cells, more than " << kMaxCylinderCells << "; raise row_height";
+    fail(what.str());
+  }
   if (!std::isfinite(max_range) || !(max_range > 0.0)) fail("max_range must be > 0");
 }
 

@@ -24,8 +24,11 @@ struct RasterConfig {
   double max_range = 5.0;     // horizontal range beyond which points are ignored
   int rows() const;           // number of cylinder rows
   // Throws std::invalid_argument naming the field unless: azimuth_bins in [1, 36000], all
-  // values finite, band_min < band_max, row_height > 0 with at least one row, max_range > 0.
+  // values finite, band_min < band_max, row_height > 0 with at least one row and at most
+  // kMaxCylinderCells cells in the cylinder, max_range > 0.
   void validate() const;
+  // 64 MB of cells; the default cylinder has 6,840, a 1 cm x 0.1 degree one over 2 m 720,000.
+  static constexpr double kMaxCylinderCells = 4e6;
   double bin_width_deg() const { return 360.0 / azimuth_bins; }
   // Row r covers heights [band_min + r * row_height, band_min + (r + 1) * row_height] above
   // the ground (the cylinder covers [band_min, band_min + rows() * row_height]).

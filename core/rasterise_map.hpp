@@ -12,9 +12,20 @@
 
 namespace sonomap {
 
-// `surface` is reused scratch and holds the band's samples afterwards (the video's top view
-// draws them).
+// What rasterise_map() reuses from call to call: the spans the map hands over and, for a map
+// that copies its samples, their copy.
+struct RasterScratch {
+  std::vector<SampleSpan> spans;
+  std::vector<Eigen::Vector3f> points;
+};
+
+// Reads the map's samples in place (Mapper::surface_spans_in_band).
 void rasterise_map(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& rasteriser,
-                   std::vector<Eigen::Vector3f>& surface);
+                   RasterScratch& scratch);
+
+// The samples the rasters take, as a copy (Mapper::surface_points_in_band over the same band
+// and disc): what the video's top view draws.
+void band_samples(const Mapper& mapper, const RasterOrigin& origin, const RasterConfig& config,
+                  std::vector<Eigen::Vector3f>& out);
 
 }  // namespace sonomap

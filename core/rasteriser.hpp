@@ -38,6 +38,9 @@ class Rasteriser {
   // keeps what one pass in order keeps. The result does not depend on the thread count.
   void add(const Eigen::Vector3f* points, std::size_t count);
   void add(const std::vector<Eigen::Vector3f>& points) { add(points.data(), points.size()); }
+  // The same as adding the spans' points one by one, span after span.
+  void add(const std::vector<SampleSpan>& spans) { add(spans.data(), spans.size()); }
+  void add(const SampleSpan* spans, std::size_t span_count);
 
   const Circle& circle() const { return cells_.circle; }
   const Cylinder& cylinder() const { return cells_.cylinder; }
@@ -47,9 +50,11 @@ class Rasteriser {
   // What the per-point pass needs of the config and the origin, as plain numbers.
   struct Placement {
     double x = 0.0, y = 0.0, ground_z = 0.0, cos_heading = 1.0, sin_heading = 0.0;
-    double band_min = 0.0, band_max = 0.0, max_range2 = 0.0, row_height = 1.0;
+    double band_min = 0.0, band_max = 0.0, max_range2 = 0.0, row_height = 1.0, rows_per_metre = 1.0;
     double bins = 1.0, bins_per_radian = 1.0;
     double margin_bins = 0.0;  // the fast arctangent's error bound, in bins
+    int32_t rows = 1, bin_count = 1;
+    double last_row_top = 1.0;  // the last row's top with a margin for the division's rounding
   };
 
  private:
@@ -62,13 +67,15 @@ class Rasteriser {
     void merge(const Cells& part);
   };
   void add_to(Cells& cells, const Eigen::Vector3f* points, std::size_t count) const;
-  // Puts a counting point in the circle's cell and the cylinder's (row < rows) where nearer.
-  static void place(Cells& cells, const Eigen::Vector3f& point, float range, int bin, int row);
+  // Adds the points [begin, end) of the spans taken one after the other.
+  void add_to(Cells& cells, const SampleSpan* spans, std::size_t span_count, std::size_t begin,
+              std::size_t end) const;
   // The bin of a point as floor(atan2(y, x) / bin width) in the body frame (x ahead, y left),
   // with the edge snapping described at add().
   int exact_bin(const Eigen::Vector3f& point) const;
-  // The row from the quotient's floor, the band's top edge kept in the last row.
-  int last_row_fix(int row, const Eigen::Vector3f& point) const;
+  // The row as floor((z - ground_z - band_min) / row_height), the band's top edge kept in the
+  // last row.
+  int exact_row(const Eigen::Vector3f& point) const;
 
   RasterConfig config_;
   RasterOrigin origin_;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -47,6 +48,12 @@ struct RasterOrigin {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double heading = 0.0;
   double ground_z = 0.0;
+};
+
+// A run of surface samples read where they lie (in a map, or in scratch its caller holds).
+struct SampleSpan {
+  const Eigen::Vector3f* points = nullptr;
+  std::size_t count = 0;
 };
 
 // Heading psi = yaw of the body x axis in the world.

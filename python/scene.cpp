@@ -96,7 +96,7 @@ void MapperSession::integrate(const SensedFrame& frame) {
 Rasters MapperSession::rasters(const SensedFrame& frame) {
   std::lock_guard<std::mutex> lock(mutex_);
   const RasterOrigin origin = raster_origin(frame.sensed.frame.world_T_body, scene_->ground_z());
-  rasterise_map(*mapper_, origin, rasteriser_, surface_);
+  rasterise_map(*mapper_, origin, rasteriser_, raster_scratch_);
   return {rasteriser_.circle(), rasteriser_.cylinder()};
 }
 

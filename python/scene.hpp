@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/mapper.hpp"
+#include "core/rasterise_map.hpp"
 #include "core/rasteriser.hpp"
 #include "eval/evaluate_frame.hpp"
 #include "harness/app/run_setup.hpp"
@@ -78,7 +79,7 @@ class MapperSession {
   std::shared_ptr<Scene> scene_;
   std::unique_ptr<Mapper> mapper_;
   Rasteriser rasteriser_;
-  std::vector<Eigen::Vector3f> surface_;
+  RasterScratch raster_scratch_;
   std::mutex mutex_;
 };
 

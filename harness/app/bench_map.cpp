@@ -82,7 +82,7 @@ class TimedMap {
     for (const auto& stage : mapper_->last_stage_times().stages)
       if (stage.first != "total") stages.push_back(stage);
     t0 = StageClock::now();
-    rasterise_map(*mapper_, raster_origin(frame.world_T_body, ground_z_), rasteriser_, surface_);
+    rasterise_map(*mapper_, raster_origin(frame.world_T_body, ground_z_), rasteriser_, raster_scratch_);
     const double raster_ms = ms_since(t0);
     stages.emplace_back("raster", raster_ms);
     stages.emplace_back("map", map_ms);
@@ -94,7 +94,7 @@ class TimedMap {
   std::unique_ptr<Mapper> mapper_;
   double ground_z_;
   Rasteriser rasteriser_;
-  std::vector<Eigen::Vector3f> surface_;
+  RasterScratch raster_scratch_;
 };
 
 // One (voxel, threads, mapper) cell: per-frame samples of every stage.

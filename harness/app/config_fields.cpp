@@ -83,7 +83,8 @@ FieldTable raster_fields(RasterConfig& c) {
       whole("azimuth_bins", &c.azimuth_bins, 1, 36000, "bins over 360 degrees"),
       number("band_min", &c.band_min, "m", -kMaxRange, kMaxRange, "obstacle band bottom, above the ground"),
       number("band_max", &c.band_max, "m", -kMaxRange, kMaxRange, "obstacle band top, above the ground"),
-      positive("row_height", &c.row_height, "m", kMaxRange, "cylinder row height"),
+      positive("row_height", &c.row_height, "m", kMaxRange,
+               "cylinder row height; rows x `azimuth_bins` at most 4,000,000"),
       positive("max_range", &c.max_range, "m", kMaxRange, "horizontal range of the rasters"),
   };
 }

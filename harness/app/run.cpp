@@ -54,9 +54,9 @@ void integrate(Mapper& mapper, const Frame& frame, FrameTimes& times) {
 }
 
 void rasterise(const Mapper& mapper, const RasterOrigin& origin, Rasteriser& rasteriser,
-               std::vector<Eigen::Vector3f>& surface, FrameTimes& times) {
+               RasterScratch& scratch, FrameTimes& times) {
   const auto t0 = StageClock::now();
-  rasterise_map(mapper, origin, rasteriser, surface);
+  rasterise_map(mapper, origin, rasteriser, scratch);
   times.emplace_back("raster", ms_since(t0));
 }
 
@@ -125,7 +125,8 @@ RunOutcome run_scenario(const RunOptions& options) {
                   schedule.frame_count(),
                   SweepClock{inputs.settings.listen.stream.period_s, inputs.settings.listen.stream.pause_s, 36});
   std::optional<eval::MovedGhosts> moved = moved_ghosts_tracker(inputs);
-  std::vector<Eigen::Vector3f> surface;
+  RasterScratch raster_scratch;
+  std::vector<Eigen::Vector3f> surface;  // the band's samples, for the video's top view
   Progress progress("run " + source.name(), schedule.frame_count(), options.quiet);
   for (int i = 0; i < schedule.frame_count(); ++i) {
     throw_if_interrupted();
@@ -134,12 +135,13 @@ RunOutcome run_scenario(const RunOptions& options) {
     integrate(*mapper, sensed.frame, times);
     if (schedule.evaluated(i)) {
       const RasterOrigin origin = raster_origin(sensed.frame.world_T_body, source.ground_z());
-      rasterise(*mapper, origin, rasteriser, surface, times);
+      rasterise(*mapper, origin, rasteriser, raster_scratch, times);
+      if (video) band_samples(*mapper, origin, rasteriser.config(), surface);
       const bool with_edf = schedule.edf(i, results.evaluated_frames());
       eval::FrameEvaluation evaluation = evaluate(inputs, *mapper, sensed, rasteriser, with_edf, times);
       if (moved) track_moved_ghosts(*moved, inputs, sensed, rasteriser, evaluation, times);
       const FrameView view{i, sensed.frame.time, origin, &rasteriser.circle(),
-                           &rasteriser.cylinder(), &surface, mapper.get(), &evaluation};
+                           &rasteriser.cylinder(), video ? &surface : nullptr, mapper.get(), &evaluation};
       results.add_frame(view, sensed.world_T_body_true, schedule.last(i));
       outputs.write(view);
       if (listen) listen->add(view);

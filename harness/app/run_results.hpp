@@ -58,7 +58,7 @@ struct FrameView {
   RasterOrigin origin;  // the estimated pose the rasters are centred on
   const Circle* circle = nullptr;
   const Cylinder* cylinder = nullptr;
-  const std::vector<Eigen::Vector3f>* surface = nullptr;  // the map's samples in the band around it
+  const std::vector<Eigen::Vector3f>* surface = nullptr;  // the band's samples (--video only)
   const Mapper* map = nullptr;  // the map itself (a sweep measures its room from the whole surface)
   const eval::FrameEvaluation* evaluation = nullptr;
 };

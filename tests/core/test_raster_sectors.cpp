@@ -48,6 +48,14 @@ TEST_CASE("An invalid raster config is rejected naming the field", "[raster]") {
   RasterConfig flat_rows;
   flat_rows.row_height = 0.0;
   CHECK_THROWS_WITH(flat_rows.validate(), Catch::Contains("row_height"));
+  // A micrometre row: 1.9 million rows of 360 cells would take 11 GB.
+  RasterConfig thin_rows;
+  thin_rows.row_height = 1e-6;
+  CHECK_THROWS_WITH(thin_rows.validate(), Catch::Contains("row_height"));
+  RasterConfig fine_enough;  // 1 cm rows of tenth-degree bins: 684,000 cells
+  fine_enough.row_height = 0.01;
+  fine_enough.azimuth_bins = 3600;
+  CHECK_NOTHROW(fine_enough.validate());
   RasterConfig nan_range;
   nan_range.max_range = NAN;
   CHECK_THROWS_WITH(nan_range.validate(), Catch::Contains("max_range"));

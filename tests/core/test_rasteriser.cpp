@@ -254,6 +254,37 @@ TEST_CASE("Every direction lands in the bin floor(atan2 / bin width) gives, also
   }
 }
 
+TEST_CASE("Every height lands in the row floor((height - band_min) / row height) gives, also a "
+          "float's step off a row edge", "[rasteriser]") {
+  // Heights spread over the band, and every row edge with the floats just under, on and over
+  // it, where the rasteriser's quotient by a product must hand over to the divided one.
+  for (double row_height : {0.1, 0.07, 0.25}) {
+    RasterConfig config;
+    config.row_height = row_height;
+    std::vector<float> heights;
+    for (int i = 0; i < 4000; ++i) heights.push_back(static_cast<float>(0.1 + 1.9 * (i + 0.29) / 4000.0));
+    for (int edge = 0; edge <= config.rows(); ++edge) {
+      const float z = static_cast<float>(config.row_bottom(edge));
+      heights.insert(heights.end(), {std::nextafter(z, 0.0f), z, std::nextafter(z, 3.0f)});
+    }
+    Rasteriser r(config);
+    for (float z : heights) for (size_t copies : {1, 8}) {
+      r.reset(RasterOrigin{});
+      r.add(std::vector<Eigen::Vector3f>(copies, Eigen::Vector3f(2.0f, 0.5f, z)));
+      const double height = static_cast<double>(z);
+      if (height < config.band_min || height > config.band_max) continue;  // another test's rule
+      int expected = static_cast<int>(std::floor((height - config.band_min) / row_height));
+      if (expected == config.rows() && height <= config.row_top(config.rows() - 1) + 1e-9) --expected;
+      INFO("height " << z << ", row height " << row_height << ", " << copies << " copies");
+      int row = -1;
+      for (int k = 0; k < config.rows(); ++k)
+        if (r.cylinder().at(k, 14).known()) row = k;
+      CHECK(row == (expected < config.rows() ? expected : -1));
+      CHECK(r.circle().bins[14].known());
+    }
+  }
+}
+
 TEST_CASE("The baseline, AVX2 and AVX-512 copies of the batch pass fill every cell to the same bit",
           "[rasteriser]") {
   // 50 000 points around a listener at (1.3, -0.7) facing 37 degrees: every azimuth, ranges
