@@ -9,10 +9,17 @@
 
 namespace sonomap {
 
-int RasterConfig::rows() const {
-  // Rows of row_height over the band; a tiny epsilon so 1.9 / 0.1 gives 19, not 18.999.
-  return static_cast<int>(std::floor((band_max - band_min) / row_height + 1e-9));
+namespace {
+
+// Rows of row_height over the band; a tiny epsilon so 1.9 / 0.1 gives 19, not 18.999. In
+// doubles, so that validate() can bound a tiny row height's count before it is an int.
+double row_count(const RasterConfig& c) {
+  return std::floor((c.band_max - c.band_min) / c.row_height + 1e-9);
 }
+
+}  // namespace
+
+int RasterConfig::rows() const { return static_cast<int>(row_count(*this)); }
 
 void RasterConfig::validate() const {
   auto fail = [](const std::string& what) {
@@ -27,13 +34,12 @@ void RasterConfig::validate() const {
          std::to_string(band_max) + ")");
   }
   if (!std::isfinite(row_height) || !(row_height > 0.0)) fail("row_height must be > 0");
-  // As rows() counts them, in doubles: a tiny row height must not overflow the count.
-  const double row_count = std::floor((band_max - band_min) / row_height + 1e-9);
-  if (row_count < 1.0) fail("row_height is taller than the band: no cylinder row fits");
-  if (row_count * azimuth_bins > kMaxCylinderCells) {
+  const double rows_in_band = row_count(*this);
+  if (rows_in_band < 1.0) fail("row_height is taller than the band: no cylinder row fits");
+  if (rows_in_band * azimuth_bins > kMaxCylinderCells) {
     std::ostringstream what;
     what << "row_height " << row_height << " m with " << azimuth_bins << " azimuth_bins makes a cylinder of "
-         << row_count * azimuth_bins << " cells, more than " << kMaxCylinderCells << "; raise row_height";
+         << rows_in_band * azimuth_bins << " cells, more than " << kMaxCylinderCells << "; raise row_height";
     fail(what.str());
   }
   if (!std::isfinite(max_range) || !(max_range > 0.0)) fail("max_range must be > 0");
